@@ -1,0 +1,101 @@
+// `marionette clip info` and `marionette clip fk`.
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <string>
+
+#include "app/commands.hpp"
+#include "app/files.hpp"
+#include "app/json.hpp"
+#include "runtime/asf_amc.hpp"
+#include "runtime/bvh.hpp"
+
+namespace marionette {
+
+namespace {
+std::string extension_of(const std::string& path) {
+    const size_t dot = path.find_last_of('.');
+    const size_t slash = path.find_last_of('/');
+    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return {};
+    std::string ext = path.substr(dot + 1);
+    for (char& c : ext) c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
+    return ext;
+}
+
+// BVH, AMC (with its ASF) or a bare ASF (skeleton only, zero frames).
+Clip load_clip(const ClipOptions& o) {
+    const std::string ext = extension_of(o.file);
+    if (ext == "bvh") return load_bvh_file(o.file);
+    if (ext == "amc") {
+        if (o.asf_file.empty()) throw ImportError(o.file, 0, "an AMC file needs its skeleton: add --asf SKELETON.asf");
+        return load_asf_amc_files(o.asf_file, o.file);
+    }
+    if (ext == "asf") {
+        Clip clip;
+        clip.skeleton = import_asf_skeleton(read_text_file(o.file), o.file);
+        clip.frame_count = 0;
+        clip.frame_rate = 120.0;
+        return clip;
+    }
+    throw ImportError(o.file, 0, "unknown clip format '." + ext + "' (expected .bvh, .amc with --asf, or .asf)");
+}
+
+std::string format_name(const std::string& path) {
+    const std::string ext = extension_of(path);
+    return ext == "bvh" ? "bvh" : (ext == "amc" ? "asf/amc" : "asf");
+}
+}  // namespace
+
+int clip_info_command(const ClipOptions& o) {
+    const Clip clip = load_clip(o);
+    const Skeleton& s = clip.skeleton;
+    if (o.json) {
+        std::string names;
+        for (const std::string& n : s.joint_names) names += (names.empty() ? "" : ",") + json::quote(n);
+        fmt::print("{{\"file\":{},\"format\":{},\"joints\":{},\"end_sites\":{},\"frames\":{},\"frame_rate\":{},"
+                   "\"duration_s\":{},\"root\":{},\"length_unit\":{},\"joint_names\":[{}]}}\n",
+                   json::quote(o.file), json::quote(format_name(o.file)), s.joint_count(), s.end_site_parents.size(),
+                   clip.frame_count, json::number(clip.frame_rate), json::number(clip.duration()),
+                   json::quote(s.joint_names.empty() ? "" : s.joint_names[0]), json::number(clip.length_unit), names);
+    } else {
+        fmt::print("{}: {} skeleton, {} joints (root {}), {} end sites\n", o.file, format_name(o.file), s.joint_count(),
+                   s.joint_names.empty() ? "-" : s.joint_names[0], s.end_site_parents.size());
+        fmt::print("{} frames at {} Hz ({:.3f} s)\n", clip.frame_count, clip.frame_rate, clip.duration());
+    }
+    return 0;
+}
+
+int clip_fk_command(const ClipOptions& o) {
+    const Clip clip = load_clip(o);
+    if (o.frame < 0 || o.frame >= clip.frame_count)
+        throw ImportError(o.file, 0,
+                          fmt::format("frame {} is out of range: the clip has {} frames (0-based indices 0..{})", o.frame,
+                                      clip.frame_count, clip.frame_count - 1));
+    const size_t n = static_cast<size_t>(clip.joint_count());
+    std::vector<quat> model_rotations(n);
+    std::vector<vec3> model_positions(n);
+    LocalToModelJob fk{clip.skeleton.parents, std::span<const quat>(clip.frame_rotations(o.frame), n),
+                       std::span<const vec3>(clip.frame_translations(o.frame), n), model_rotations, model_positions};
+    fk.run();
+    const Skeleton& s = clip.skeleton;
+    if (o.json) {
+        std::string out = "{\"joints\":[";
+        for (size_t j = 0; j < n; ++j) {
+            const int p = s.parents[j];
+            out += fmt::format("{}{{\"name\":{},\"parent\":{},\"position\":[{},{},{}]}}", j ? "," : "",
+                               json::quote(s.joint_names[j]),
+                               p == kNoParent ? std::string("null") : json::quote(s.joint_names[static_cast<size_t>(p)]),
+                               json::number(model_positions[j].x), json::number(model_positions[j].y),
+                               json::number(model_positions[j].z));
+        }
+        fmt::print("{}]}}\n", out);
+    } else {
+        fmt::print("{} frame {} (world space, file units)\n", o.file, o.frame);
+        for (size_t j = 0; j < n; ++j)
+            fmt::print("{:>24} {:12.5f} {:12.5f} {:12.5f}\n", s.joint_names[j], model_positions[j].x,
+                       model_positions[j].y, model_positions[j].z);
+    }
+    return 0;
+}
+
+}  // namespace marionette

@@ -1,0 +1,47 @@
+#pragma once
+// One function per `marionette` subcommand; main.cpp only parses the command line.
+// Each returns the process exit code: 0 success, 1 failure, 2 bad input.
+#include <string>
+
+namespace marionette {
+
+struct RunOptions {
+    std::string config_file;
+    std::string input = "sim:builtin:demo";  // sim:PROGRAM (a file, or builtin:NAME)
+    std::string display = "auto";
+    std::string record_file;
+    std::string trace_file;
+    double duration_s = -1.0;                // < 0: until the program ends
+    bool fast = false;                       // no real-time pacing
+};
+int run_command(const RunOptions& options);
+
+struct RecordOptions {
+    std::string program_file;
+    std::string output_file;
+    std::string config_file;
+    unsigned chunk_ticks = 60;               // 250 ms at 240 Hz, as a live run flushes
+    bool json = false;
+};
+int record_command(const RecordOptions& options);
+
+struct ReplayCommandOptions {
+    std::string log_file;
+    bool print_hash = false;
+    bool json = false;
+    std::string trace_csv;
+    std::string joints_csv;
+    std::string bvh;
+};
+int replay_command(const ReplayCommandOptions& options);
+
+struct ClipOptions {
+    std::string file;
+    std::string asf_file;
+    int frame = 0;
+    bool json = false;
+};
+int clip_info_command(const ClipOptions& options);
+int clip_fk_command(const ClipOptions& options);
+
+}  // namespace marionette

@@ -1,0 +1,189 @@
+#include "app/config.hpp"
+
+#include <toml++/toml.h>
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <variant>
+
+#include "app/embedded.hpp"
+
+namespace marionette {
+
+namespace {
+
+using IntField = std::int32_t SimConfig::*;
+using FloatField = float SimConfig::*;
+
+struct KeySpec {
+    const char* table;
+    const char* key;
+    std::variant<IntField, FloatField> field;
+    double min;
+    double max;
+    const char* doc;
+};
+
+// The schema: one line per key. docs/config.md documents each (a test checks).
+const KeySpec kKeys[] = {
+    {"simulation", "tick_rate_hz", &SimConfig::tick_rate_hz, 30, 2000, "fixed simulation rate (ticks per second)"},
+    {"simulation", "max_catch_up_ticks", &SimConfig::max_catch_up_ticks, 1, 1000, "most ticks run after one wake-up before the backlog is dropped"},
+    {"puppet", "pelvis_height", &SimConfig::pelvis_height, 0.3, 2.0, "hip joint height above the ground when standing (m)"},
+    {"puppet", "hip_width", &SimConfig::hip_width, 0.05, 0.6, "distance between the hip joints (m)"},
+    {"puppet", "thigh_length", &SimConfig::thigh_length, 0.1, 1.0, "hip to knee (m)"},
+    {"puppet", "shin_length", &SimConfig::shin_length, 0.1, 1.0, "knee to ankle (m)"},
+    {"puppet", "ankle_height", &SimConfig::ankle_height, 0.01, 0.3, "ankle above the sole (m)"},
+    {"puppet", "foot_length", &SimConfig::foot_length, 0.03, 0.5, "ankle to the ball of the foot (m)"},
+    {"puppet", "toe_length", &SimConfig::toe_length, 0.01, 0.3, "ball of the foot to the tip of the toes (m)"},
+    {"puppet", "spine_length", &SimConfig::spine_length, 0.2, 1.2, "pelvis to the base of the neck (m)"},
+    {"puppet", "neck_length", &SimConfig::neck_length, 0.02, 0.4, "base of the neck to the head joint (m)"},
+    {"puppet", "head_length", &SimConfig::head_length, 0.05, 0.5, "head joint to the top of the head (m)"},
+    {"puppet", "shoulder_width", &SimConfig::shoulder_width, 0.1, 1.0, "distance between the shoulder joints (m)"},
+    {"puppet", "upper_arm_length", &SimConfig::upper_arm_length, 0.05, 0.8, "shoulder to elbow (m)"},
+    {"puppet", "forearm_length", &SimConfig::forearm_length, 0.05, 0.8, "elbow to wrist (m)"},
+    {"puppet", "hand_length", &SimConfig::hand_length, 0.02, 0.4, "wrist to fingertips (m)"},
+    {"locomotion", "max_speed", &SimConfig::max_speed, 0.1, 12.0, "speed at full stick deflection (m/s)"},
+    {"locomotion", "walk_cycle_speed", &SimConfig::walk_cycle_speed, 0.1, 10.0, "speed at which the walk clip is fully blended in (m/s)"},
+    {"locomotion", "stride_length", &SimConfig::stride_length, 0.2, 5.0, "distance covered by one walk cycle, two steps (m)"},
+    {"locomotion", "acceleration", &SimConfig::acceleration, 0.1, 100.0, "how fast velocity follows the stick (m/s²)"},
+    {"locomotion", "turn_rate_deg_s", &SimConfig::turn_rate_deg_s, 1.0, 3600.0, "how fast the heading follows the direction of travel (°/s)"},
+    {"locomotion", "stick_deadzone", &SimConfig::stick_deadzone, 0.0, 0.9, "radial deadzone, fraction of full deflection"},
+    {"locomotion", "response_curve", &SimConfig::response_curve, 0.0, 1.0, "0 linear … 1 quadratic response of speed to deflection"},
+};
+
+int line_of(const toml::node& node) { return static_cast<int>(node.source().begin.line); }
+
+std::string known_keys_of(std::string_view table) {
+    std::string out;
+    for (const KeySpec& k : kKeys)
+        if (table == k.table) out += (out.empty() ? "" : ", ") + std::string(k.key);
+    return out;
+}
+
+std::string known_tables() {
+    std::string out;
+    std::string last;
+    for (const KeySpec& k : kKeys)
+        if (last != k.table) {
+            out += (out.empty() ? "" : ", ") + std::string(k.table);
+            last = k.table;
+        }
+    return out;
+}
+
+template <typename Number>
+std::string format_number(Number v) {
+    char buf[64];
+    const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+    (void)ec;
+    std::string s(buf, end);
+    if (s.find_first_of(".eE") == std::string::npos && s.find("inf") == std::string::npos) s += ".0";
+    return s;
+}
+
+std::string read_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw ConfigError(path, 0, "", "cannot open the configuration file");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+}  // namespace
+
+std::vector<ConfigKeyInfo> config_schema() {
+    std::vector<ConfigKeyInfo> out;
+    for (const KeySpec& k : kKeys)
+        out.push_back({k.table, k.key, std::holds_alternative<IntField>(k.field) ? "integer" : "float", k.min, k.max, k.doc});
+    return out;
+}
+
+SimConfig apply_config_text(const SimConfig& base, std::string_view text, const std::string& file) {
+    toml::table doc;
+    try {
+        doc = toml::parse(text, file);
+    } catch (const toml::parse_error& e) {
+        throw ConfigError(file, static_cast<int>(e.source().begin.line), "",
+                          "TOML syntax error: " + std::string(e.description()));
+    }
+    SimConfig config = base;
+    for (const auto& [table_key, table_node] : doc) {
+        const std::string table_name(table_key.str());
+        const std::string known = known_keys_of(table_name);
+        if (known.empty())
+            throw ConfigError(file, line_of(table_node), table_name,
+                              "unknown table (expected one of: " + known_tables() + ")");
+        const toml::table* table = table_node.as_table();
+        if (!table) throw ConfigError(file, line_of(table_node), table_name, "expected a table ([" + table_name + "])");
+        for (const auto& [key, node] : *table) {
+            const std::string full = table_name + "." + std::string(key.str());
+            const KeySpec* spec = nullptr;
+            for (const KeySpec& k : kKeys)
+                if (table_name == k.table && key.str() == k.key) spec = &k;
+            if (!spec)
+                throw ConfigError(file, line_of(node), full, "unknown key (expected one of: " + known + ")");
+            const std::string range = "[" + format_number(spec->min) + ", " + format_number(spec->max) + "]";
+            if (std::holds_alternative<IntField>(spec->field)) {
+                const auto* v = node.as_integer();
+                if (!v) throw ConfigError(file, line_of(node), full, "expected an integer in " + range);
+                const std::int64_t value = v->get();
+                if (value < spec->min || value > spec->max)
+                    throw ConfigError(file, line_of(node), full,
+                                      std::to_string(value) + " is out of range: expected an integer in " + range);
+                config.*std::get<IntField>(spec->field) = static_cast<std::int32_t>(value);
+            } else {
+                double value = 0.0;
+                if (const auto* f = node.as_floating_point()) value = f->get();
+                else if (const auto* i = node.as_integer()) value = static_cast<double>(i->get());
+                else throw ConfigError(file, line_of(node), full, "expected a number in " + range);
+                if (!std::isfinite(value) || value < spec->min || value > spec->max)
+                    throw ConfigError(file, line_of(node), full,
+                                      format_number(value) + " is out of range: expected a number in " + range);
+                config.*std::get<FloatField>(spec->field) = static_cast<float>(value);
+            }
+        }
+    }
+    // Relations between keys.
+    if (config.pelvis_height > config.thigh_length + config.shin_length + config.ankle_height + 1e-4f)
+        throw ConfigError(file, doc["puppet"]["pelvis_height"].node() ? line_of(*doc["puppet"]["pelvis_height"].node()) : 0,
+                          "puppet.pelvis_height",
+                          "must not exceed thigh_length + shin_length + ankle_height, or the feet cannot reach the ground");
+    return config;
+}
+
+std::string_view default_config_text() { return embedded::find("config/marionette.toml"); }
+
+SimConfig default_config() { return apply_config_text(SimConfig{}, default_config_text(), "config/marionette.toml"); }
+
+SimConfig load_config(const std::string& user_file) {
+    SimConfig config = default_config();
+    if (!user_file.empty()) config = apply_config_text(config, read_file(user_file), user_file);
+    return config;
+}
+
+std::string serialize_config(const SimConfig& config) {
+    std::string out = "# marionette effective configuration\n";
+    std::string table;
+    for (const KeySpec& k : kKeys) {
+        if (table != k.table) {
+            table = k.table;
+            out += "\n[" + table + "]\n";
+        }
+        out += std::string(k.key) + " = ";
+        if (std::holds_alternative<IntField>(k.field))
+            out += std::to_string(config.*std::get<IntField>(k.field));
+        else
+            // Shortest text that reads back to the same float (to_chars round-trips).
+            out += format_number(config.*std::get<FloatField>(k.field));
+        out += "\n";
+    }
+    return out;
+}
+
+SimConfig config_from_text(std::string_view text, const std::string& origin) {
+    return apply_config_text(default_config(), text, origin);
+}
+
+}  // namespace marionette

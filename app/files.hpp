@@ -1,0 +1,42 @@
+#pragma once
+// File helpers for the commands: whole-file reads, and an input-log file that
+// writes chunks as the run goes so a crash loses at most the unflushed chunk.
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "runtime/input_log.hpp"
+
+namespace marionette {
+
+// Throws ImportError naming the path when it cannot be read.
+std::vector<std::uint8_t> read_binary_file(const std::string& path);
+std::string read_text_file(const std::string& path);
+// Writes atomically enough for outputs (truncate + write); throws std::runtime_error.
+void write_text_file(const std::string& path, const std::string& text);
+
+class InputLogFile {
+public:
+    // Creates the file and writes the header; throws std::runtime_error on failure.
+    InputLogFile(const std::string& path, const InputLogHeader& header);
+    ~InputLogFile();
+    InputLogFile(const InputLogFile&) = delete;
+    InputLogFile& operator=(const InputLogFile&) = delete;
+
+    void append_tick(const TickInput& input) { encoder_.append_tick(input); }
+    void append_config_change(const std::string& text) { encoder_.append_config_change(text); }
+    std::uint32_t pending_ticks() const { return encoder_.pending_ticks(); }
+    // Ends the current chunk and writes it to the file (and the OS).
+    void flush();
+    // Writes the end marker and closes; the destructor does this too.
+    void close();
+
+private:
+    std::string path_;
+    std::FILE* file_ = nullptr;
+    InputLogEncoder encoder_;
+    std::vector<std::uint8_t> buffer_;
+};
+
+}  // namespace marionette

@@ -1,0 +1,68 @@
+// `marionette record` and `marionette replay`.
+#include <fmt/format.h>
+
+#include "app/commands.hpp"
+#include "app/config.hpp"
+#include "app/files.hpp"
+#include "app/json.hpp"
+#include "app/program_source.hpp"
+#include "app/replay.hpp"
+
+namespace marionette {
+
+int record_command(const RecordOptions& o) {
+    const SimConfig config = load_config(o.config_file);
+    const StickProgram program = load_program(o.program_file);
+    const std::vector<TickInput> ticks = render_stick_program(program, config.tick_rate_hz);
+
+    set_simulation_float_mode();
+    Simulation sim(config);
+    InputLogHeader header;
+    header.tick_rate_hz = static_cast<std::uint32_t>(config.tick_rate_hz);
+    header.clip_data_hash = sim.clip_data_hash();
+    header.config_text = serialize_config(config);
+    InputLogFile log(o.output_file, header);
+    for (const TickInput& input : ticks) {
+        sim.step(input);
+        log.append_tick(input);
+        if (log.pending_ticks() >= o.chunk_ticks) log.flush();
+    }
+    log.close();
+    const std::uint64_t hash = hash_state(sim.state());
+    if (o.json) {
+        fmt::print("{{\"log\":{},\"program\":{},\"ticks\":{},\"duration_s\":{},\"final_hash\":\"{:016x}\"}}\n",
+                   json::quote(o.output_file), json::quote(o.program_file), ticks.size(),
+                   json::number(static_cast<double>(ticks.size()) / config.tick_rate_hz), hash);
+    } else {
+        fmt::print("recorded {} ticks ({:.2f} s at {} Hz) from {} to {}; final state hash {:016x}\n", ticks.size(),
+                   static_cast<double>(ticks.size()) / config.tick_rate_hz, config.tick_rate_hz, o.program_file,
+                   o.output_file, hash);
+    }
+    return 0;
+}
+
+int replay_command(const ReplayCommandOptions& o) {
+    const DecodedInputLog log = decode_input_log(read_binary_file(o.log_file), o.log_file);
+    if (!log.warning.empty()) fmt::print(stderr, "warning: {}\n", log.warning);
+    ReplayOptions options;
+    options.trace_csv = o.trace_csv;
+    options.joints_csv = o.joints_csv;
+    options.bvh = o.bvh;
+    const ReplayResult r = replay_log(log, o.log_file, options);
+    if (o.json) {
+        fmt::print("{{\"log\":{},\"ticks\":{},\"tick_rate_hz\":{},\"duration_s\":{},\"final_hash\":\"{:016x}\","
+                   "\"complete\":{},\"warning\":{},\"config_changes\":{},\"distance_m\":{},\"final_root_position\":[{},{},{}]}}\n",
+                   json::quote(o.log_file), r.ticks, log.header.tick_rate_hz, json::number(r.duration_s), r.final_hash,
+                   log.complete ? "true" : "false", log.warning.empty() ? "null" : json::quote(log.warning),
+                   r.config_changes, json::number(r.distance_m), json::number(r.final_root_position.x),
+                   json::number(r.final_root_position.y), json::number(r.final_root_position.z));
+    } else if (o.print_hash) {
+        fmt::print("{:016x}\n", r.final_hash);
+    } else {
+        fmt::print("replayed {} ticks ({:.2f} s); root travelled {:.2f} m; final state hash {:016x}\n", r.ticks,
+                   r.duration_s, r.distance_m, r.final_hash);
+    }
+    return 0;
+}
+
+}  // namespace marionette

@@ -1,0 +1,22 @@
+# Compile options for marionette's own targets. Third-party headers come in as
+# SYSTEM includes through their imported targets, so -Werror applies to our code only.
+
+add_library(marionette_options INTERFACE)
+target_compile_options(marionette_options INTERFACE
+  -Wall -Wextra -Wpedantic -Werror
+  # Determinism (DESIGN.md): never fast-math, never fuse a*b+c into an FMA,
+  # so every build type and both compilers round identically.
+  -ffp-contract=off -fno-fast-math)
+target_compile_definitions(marionette_options INTERFACE
+  GLM_FORCE_RADIANS GLM_FORCE_CTOR_INIT GLM_FORCE_XYZW_ONLY)
+
+if(MARIONETTE_SANITIZE STREQUAL "address")
+  target_compile_options(marionette_options INTERFACE
+    -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
+  target_link_options(marionette_options INTERFACE -fsanitize=address,undefined)
+elseif(MARIONETTE_SANITIZE STREQUAL "thread")
+  target_compile_options(marionette_options INTERFACE -fsanitize=thread -fno-omit-frame-pointer)
+  target_link_options(marionette_options INTERFACE -fsanitize=thread)
+elseif(NOT MARIONETTE_SANITIZE STREQUAL "")
+  message(FATAL_ERROR "MARIONETTE_SANITIZE must be '', 'address' or 'thread'")
+endif()

@@ -1,0 +1,40 @@
+#pragma once
+// Every tunable the simulation reads, as plain data. Loading, validation and the
+// documentation of each key live with the TOML schema (app/config.cpp,
+// docs/config.md); the defaults here are the ones config/marionette.toml states.
+#include <cstdint>
+
+namespace marionette {
+
+struct SimConfig {
+    // [simulation]
+    std::int32_t tick_rate_hz = 240;
+    std::int32_t max_catch_up_ticks = 8;   // real-time driver: ticks run per wake-up at most
+
+    // [puppet] proportions in metres
+    float pelvis_height = 0.95f;           // hip joint height above the ground when standing
+    float hip_width = 0.18f;
+    float thigh_length = 0.44f;
+    float shin_length = 0.43f;
+    float ankle_height = 0.08f;
+    float foot_length = 0.14f;
+    float toe_length = 0.06f;
+    float spine_length = 0.50f;            // pelvis to neck, split over three spine joints
+    float neck_length = 0.10f;
+    float head_length = 0.22f;
+    float shoulder_width = 0.36f;
+    float upper_arm_length = 0.29f;
+    float forearm_length = 0.26f;
+    float hand_length = 0.18f;
+
+    // [locomotion]
+    float max_speed = 3.0f;                // m/s at full stick deflection
+    float walk_cycle_speed = 1.4f;         // speed the generated walk clip plays at 1×
+    float stride_length = 1.4f;            // metres per full walk cycle at walk_cycle_speed
+    float acceleration = 6.0f;             // m/s² toward the commanded velocity
+    float turn_rate_deg_s = 360.0f;        // heading follows the movement direction
+    float stick_deadzone = 0.12f;          // radial, fraction of full deflection
+    float response_curve = 0.5f;           // 0 linear … 1 quadratic: f(d) = (1−c)·d + c·d²
+};
+
+}  // namespace marionette

@@ -1,0 +1,75 @@
+#pragma once
+// The fixed-timestep simulation: state(k+1) = step(state(k), tick_input(k), config).
+// The state is plain, fixed-size data (no pointers, no heap), so it can be copied
+// between threads, hashed field by field and compared bit for bit.
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "runtime/clip.hpp"
+#include "runtime/sim_config.hpp"
+#include "runtime/tick_input.hpp"
+
+namespace marionette {
+
+inline constexpr int kMaxJoints = 64;
+
+struct PuppetState {
+    std::uint64_t tick = 0;            // ticks completed
+    std::int32_t joint_count = 0;
+    TickInput input{};                 // the input of the last tick
+    vec3 root_position{0.0f};          // ground point under the pelvis, world metres
+    vec2 velocity{0.0f};               // world XZ, m/s
+    float heading = 0.0f;              // radians; facing (sin h, 0, cos h)
+    float walk_phase = 0.0f;           // [0, 1) through the walk cycle
+    float idle_time = 0.0f;            // seconds into the idle clip
+    float locomotion_blend = 0.0f;     // 0 idle … 1 walking
+    std::array<quat, kMaxJoints> local_rotations{};
+    std::array<vec3, kMaxJoints> local_translations{};
+    std::array<quat, kMaxJoints> model_rotations{};   // world space
+    std::array<vec3, kMaxJoints> model_positions{};   // world space
+};
+
+// 64-bit xxHash over every field of the state (joints past joint_count excluded),
+// fed field by field so padding never enters it.
+std::uint64_t hash_state(const PuppetState& state);
+
+class Simulation {
+public:
+    // Builds the puppet and its clips (allocates); step() never does.
+    explicit Simulation(const SimConfig& config);
+
+    // Advances exactly one tick of 1/tick_rate_hz seconds.
+    void step(const TickInput& input);
+
+    // Applies a new configuration at the tick boundary (live tuning). Structural
+    // settings (tick rate, puppet proportions) cannot change while running: the
+    // call then changes nothing and returns the name of the first such key.
+    std::string retune(const SimConfig& config);
+
+    const PuppetState& state() const { return state_; }
+    const SimConfig& config() const { return config_; }
+    const Skeleton& skeleton() const { return idle_clip_.skeleton; }
+    double tick_seconds() const { return 1.0 / config_.tick_rate_hz; }
+    // Hash of the clip data the puppet animates, recorded in input logs.
+    std::uint64_t clip_data_hash() const { return clip_data_hash_; }
+
+private:
+    void update_model_space();
+
+    SimConfig config_;
+    Clip idle_clip_;
+    Clip walk_clip_;
+    std::uint64_t clip_data_hash_ = 0;
+    PuppetState state_;
+    // Scratch for the blend (fixed size: no allocation in step()).
+    std::array<quat, kMaxJoints> walk_rotations_{};
+    std::array<vec3, kMaxJoints> walk_translations_{};
+};
+
+// Sets flush-to-zero / denormals-are-zero on the calling thread, the same way on
+// every thread that simulates (run and replay alike): denormals are slow and a
+// flag set on one path only would break replay.
+void set_simulation_float_mode();
+
+}  // namespace marionette

@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages marionette needs, when missing. Idempotent;
+# runs as root or through sudo; downloads nothing but Debian packages.
+set -euo pipefail
+
+packages=(
+  # toolchain
+  g++ cmake ninja-build pkg-config make git ca-certificates python3
+  # runtime and tools
+  libglm-dev libxxhash-dev zlib1g-dev libtomlplusplus-dev libcli11-dev libfmt-dev libspdlog-dev
+  # tests and benchmarks
+  catch2 libbenchmark-dev
+)
+# Later issues append their libraries here (libevdev, hidapi, SDL2, EGL/GLES, GBM/DRM, umockdev, stb).
+if [[ "${MARIONETTE_SETUP_CLANG:-0}" == 1 ]]; then packages+=(clang-14); fi
+
+missing=()
+for p in "${packages[@]}"; do
+  status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
+  [[ "$status" == "install ok installed" ]] || missing+=("$p")
+done
+if ((${#missing[@]} == 0)); then
+  echo "setup: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+if [[ $(id -u) -eq 0 ]]; then
+  sudo=()
+elif command -v sudo >/dev/null 2>&1; then
+  sudo=(sudo)
+else
+  echo "setup: need root (or sudo) to install: ${missing[*]}" >&2
+  exit 1
+fi
+echo "setup: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+"${sudo[@]}" apt-get update -qq
+"${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

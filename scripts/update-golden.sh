@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Regenerates tests/golden/*.trace.csv after a change that alters the simulation
+# on purpose. Review the diff (git diff --stat tests/golden) and say why in the
+# commit message: a golden change is a behaviour change.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cmake --preset release >/dev/null
+cmake --build --preset release --target marionette
+bin=build/release/app/marionette
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+for program in stand_still walk_stop circle demo; do
+  "$bin" record --program "config/programs/$program.prog" -o "$tmp/$program.mlog" >/dev/null
+  "$bin" replay "$tmp/$program.mlog" --trace "tests/golden/$program.trace.csv"
+done
