@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <string>
 
+#include "app/cli.hpp"
 #include "app/commands.hpp"
 #include "app/files.hpp"
 #include "app/json.hpp"
@@ -96,6 +97,22 @@ int clip_fk_command(const ClipOptions& o) {
                        model_positions[j].y, model_positions[j].z);
     }
     return 0;
+}
+
+void register_clip_commands(CLI::App& app, int& exit_code) {
+    auto o = std::make_shared<ClipOptions>();
+    CLI::App* clip = app.add_subcommand("clip", "Inspect motion-capture clips (BVH, ASF/AMC)");
+    clip->require_subcommand(1);
+    CLI::App* info = clip->add_subcommand("info", "Skeleton and frame summary");
+    CLI::App* fk = clip->add_subcommand("fk", "World-space joint positions of one frame");
+    for (CLI::App* c : {info, fk}) {
+        c->add_option("file", o->file, "clip file (.bvh, .amc, .asf)")->required();
+        c->add_option("--asf", o->asf_file, "skeleton for an AMC file");
+        c->add_flag("--json", o->json, "print JSON");
+    }
+    fk->add_option("--frame", o->frame, "0-based frame index in the file")->required();
+    on_parsed(info, exit_code, [o] { return clip_info_command(*o); });
+    on_parsed(fk, exit_code, [o] { return clip_fk_command(*o); });
 }
 
 }  // namespace marionette

@@ -1,6 +1,7 @@
 // `marionette record` and `marionette replay`.
 #include <fmt/format.h>
 
+#include "app/cli.hpp"
 #include "app/commands.hpp"
 #include "app/config.hpp"
 #include "app/files.hpp"
@@ -63,6 +64,27 @@ int replay_command(const ReplayCommandOptions& o) {
                    r.duration_s, r.distance_m, r.final_hash);
     }
     return 0;
+}
+
+void register_log_commands(CLI::App& app, int& exit_code) {
+    auto rec = std::make_shared<RecordOptions>();
+    CLI::App* record = app.add_subcommand("record", "Make an input log from a scripted stick program");
+    record->add_option("--program", rec->program_file, "stick program file (or builtin:NAME)")->required();
+    record->add_option("-o,--output", rec->output_file, "input log to write")->required();
+    record->add_option("--config", rec->config_file, "TOML file overriding the defaults")->check(CLI::ExistingFile);
+    record->add_option("--chunk-ticks", rec->chunk_ticks, "ticks per log chunk")->check(CLI::Range(1u, 1u << 20));
+    record->add_flag("--json", rec->json, "print a JSON summary");
+    on_parsed(record, exit_code, [rec] { return record_command(*rec); });
+
+    auto rep = std::make_shared<ReplayCommandOptions>();
+    CLI::App* replay = app.add_subcommand("replay", "Replay an input log exactly, with no clock");
+    replay->add_option("log", rep->log_file, "input log")->required();
+    replay->add_flag("--hash", rep->print_hash, "print the final state hash");
+    replay->add_option("--trace", rep->trace_csv, "per-tick CSV: tick,hash,root_x,root_y,root_z");
+    replay->add_option("--joints-csv", rep->joints_csv, "per-tick CSV of every joint's world position");
+    replay->add_option("--bvh", rep->bvh, "export the performed motion as BVH");
+    replay->add_flag("--json", rep->json, "print a JSON summary");
+    on_parsed(replay, exit_code, [rep] { return replay_command(*rep); });
 }
 
 }  // namespace marionette

@@ -9,6 +9,7 @@
 #include <memory>
 #include <thread>
 
+#include "app/cli.hpp"
 #include "app/commands.hpp"
 #include "app/config.hpp"
 #include "app/files.hpp"
@@ -116,6 +117,19 @@ int run_command(const RunOptions& o) {
                g_stop_requested.load() ? "stopped" : "demo finished", static_cast<double>(s.tick) / config.tick_rate_hz,
                s.tick, distance, top_speed, driver.catch_up_cap_hits, hash_state(s));
     return 0;
+}
+
+void register_run_command(CLI::App& app, int& exit_code) {
+    auto o = std::make_shared<RunOptions>();
+    CLI::App* cmd = app.add_subcommand("run", "Run the puppet live (headless demo with a simulated controller by default)");
+    cmd->add_option("--config", o->config_file, "TOML file overriding the defaults")->check(CLI::ExistingFile);
+    cmd->add_option("--input", o->input, "sim:PROGRAM (a stick program file, or builtin:NAME)");
+    cmd->add_option("--display", o->display, "auto|headless")->check(CLI::IsMember({"auto", "headless", "kms", "window"}));
+    cmd->add_option("--record", o->record_file, "write the input log here");
+    cmd->add_option("--trace", o->trace_file, "per-tick CSV: tick,hash,root_x,root_y,root_z");
+    cmd->add_option("--duration", o->duration_s, "seconds to run (default: until the program ends)")->check(CLI::Range(0.0, 86400.0));
+    cmd->add_flag("--fast", o->fast, "do not pace ticks in real time");
+    on_parsed(cmd, exit_code, [o] { return run_command(*o); });
 }
 
 }  // namespace marionette
