@@ -48,7 +48,7 @@ TEST_CASE("det::atan2, acos and asin match libm", "[det_math]") {
     CHECK(det::atan2(-1.0, 0.0) == Approx(-det::kHalfPi));
 }
 
-TEST_CASE("wrap_angle maps to (-pi, pi]", "[det_math]") {
+TEST_CASE("wrap_angle maps into the interval from -pi (excluded) to pi", "[det_math]") {
     CHECK(det::wrap_angle(3 * det::kPi) == Approx(det::kPi));
     CHECK(det::wrap_angle(-det::kPi) == Approx(det::kPi));
     CHECK(det::wrap_angle(0.25) == Approx(0.25));
