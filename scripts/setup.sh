@@ -10,8 +10,13 @@ packages=(
   libglm-dev libxxhash-dev zlib1g-dev libtomlplusplus-dev libcli11-dev libfmt-dev libspdlog-dev
   # tests and benchmarks
   catch2 libbenchmark-dev
+  # input: evdev, raw HID, SDL2; umockdev and evemu run the evdev path without hardware
+  libevdev-dev libhidapi-dev libsdl2-dev umockdev libumockdev-dev evemu-tools
+  # render_es: EGL + GLES 3, KMS/GBM, seat access, PNG output; Mesa's llvmpipe for headless runs
+  libegl-dev libgles-dev libgbm-dev libdrm-dev libseat-dev libstb-dev libegl-mesa0 libgl1-mesa-dri xvfb xauth
+  # motion graph: BLAS for the distance matrix
+  libopenblas-dev
 )
-# Later issues append their libraries here (libevdev, hidapi, SDL2, EGL/GLES, GBM/DRM, umockdev, stb).
 if [[ "${MARIONETTE_SETUP_CLANG:-0}" == 1 ]]; then packages+=(clang-14); fi
 
 missing=()
