@@ -3,6 +3,9 @@
 // documentation of each key live with the TOML schema (app/config.cpp,
 // docs/config.md); the defaults here are the ones config/marionette.toml states.
 #include <cstdint>
+#include <string>
+
+#include "runtime/terrain.hpp"
 
 namespace marionette {
 
@@ -35,6 +38,13 @@ struct SimConfig {
     float turn_rate_deg_s = 360.0f;        // heading follows the movement direction
     float stick_deadzone = 0.12f;          // radial, fraction of full deflection
     float response_curve = 0.5f;           // 0 linear … 1 quadratic: f(d) = (1−c)·d + c·d²
+
+    // [terrain] the ground walked on: `name` is where it came from (a built-in
+    // name or a file path, resolved by app/); the data travel inline in every
+    // effective configuration, so a log fully determines its ground. Built-in
+    // default: flat (the shipped config/marionette.toml names stairs).
+    std::string terrain_name = "flat";
+    Terrain terrain;
 };
 
 }  // namespace marionette

@@ -64,6 +64,7 @@ std::string Simulation::retune(const SimConfig& next) {
         &SimConfig::upper_arm_length, &SimConfig::forearm_length, &SimConfig::hand_length};
     for (auto field : structural)
         if (next.*field != c.*field) return "puppet (skeleton proportions)";
+    if (!(next.terrain == c.terrain)) return "terrain";
     config_ = next;
     return {};
 }
