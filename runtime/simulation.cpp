@@ -39,7 +39,7 @@ void set_simulation_float_mode() {
 #endif
 }
 
-Simulation::Simulation(const SimConfig& config) : config_(config) {
+Simulation::Simulation(const SimConfig& config, const Terrain& terrain) : config_(config), terrain_(terrain) {
     if (config_.tick_rate_hz <= 0) throw std::invalid_argument("tick_rate_hz must be positive");
     const Skeleton skeleton = make_puppet_skeleton(config_);
     if (skeleton.joint_count() > kMaxJoints) throw std::invalid_argument("puppet has too many joints");
