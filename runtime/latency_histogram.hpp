@@ -36,6 +36,7 @@ struct DurationHistogram {
         for (int b = 0; b < Buckets; ++b) {
             seen += buckets[static_cast<std::size_t>(b)];
             if (seen >= target) {
+                if (b == Buckets - 1) return max_ns;  // the overflow bucket has no upper edge
                 const std::int64_t edge = (b + 1) * BucketNs;
                 return edge < max_ns ? edge : max_ns;
             }
