@@ -52,6 +52,14 @@ const KeySpec kKeys[] = {
     {"locomotion", "turn_rate_deg_s", &SimConfig::turn_rate_deg_s, 1.0, 3600.0, "how fast the heading follows the direction of travel (°/s)"},
     {"locomotion", "stick_deadzone", &SimConfig::stick_deadzone, 0.0, 0.9, "radial deadzone, fraction of full deflection"},
     {"locomotion", "response_curve", &SimConfig::response_curve, 0.0, 1.0, "0 linear … 1 quadratic response of speed to deflection"},
+    // [realtime]: `marionette run` thread settings, applied at start only.
+    {"realtime", "input_priority", &SimConfig::input_priority, 0, 99, "SCHED_FIFO priority of the input thread (0: normal scheduling)"},
+    {"realtime", "simulation_priority", &SimConfig::simulation_priority, 0, 99, "SCHED_FIFO priority of the simulation thread (0: normal scheduling)"},
+    {"realtime", "render_priority", &SimConfig::render_priority, 0, 99, "SCHED_FIFO priority of the render thread (0: normal scheduling)"},
+    {"realtime", "input_cpu", &SimConfig::input_cpu, -1, 1023, "CPU the input thread is pinned to (-1: any)"},
+    {"realtime", "simulation_cpu", &SimConfig::simulation_cpu, -1, 1023, "CPU the simulation thread is pinned to (-1: any)"},
+    {"realtime", "render_cpu", &SimConfig::render_cpu, -1, 1023, "CPU the render thread is pinned to (-1: any)"},
+    {"realtime", "lock_memory", &SimConfig::lock_memory, 0, 1, "1: lock all memory (mlockall) before the threads start"},
 };
 
 int line_of(const toml::node& node) { return static_cast<int>(node.source().begin.line); }

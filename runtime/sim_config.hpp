@@ -45,6 +45,15 @@ struct SimConfig {
     // default: flat (the shipped config/marionette.toml names stairs).
     std::string terrain_name = "flat";
     Terrain terrain;
+    // [realtime] `marionette run` thread settings (app/realtime.cpp); never read by
+    // the tick. Priority 0 = normal scheduling, 1–99 = SCHED_FIFO; cpu −1 = any.
+    std::int32_t input_priority = 0;
+    std::int32_t simulation_priority = 0;
+    std::int32_t render_priority = 0;
+    std::int32_t input_cpu = -1;
+    std::int32_t simulation_cpu = -1;
+    std::int32_t render_cpu = -1;
+    std::int32_t lock_memory = 0;          // 1: mlockall(MCL_CURRENT | MCL_FUTURE) before the threads start
 };
 
 }  // namespace marionette
