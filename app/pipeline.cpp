@@ -30,9 +30,11 @@ void SimulationLoop::apply(const SimConfig& config) {
     // The watcher refused structural changes already, and a log's changes were
     // checked when it was decoded, so retune cannot fail here.
     if (!sim_.retune(config).empty()) return;
+    const auto slot = static_cast<std::uint32_t>(config_changes_ % PipelineShared::kAppliedConfigSlots);
     ++config_changes_;
+    shared_.applied_configs[slot] = config;  // a live edit may allocate here: not the steady state
     record_.kind = TickRecord::Kind::config_change;
-    record_.config = config;
+    record_.config_slot = slot;
     push(record_);
 }
 
@@ -444,10 +446,11 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
     auto handle = [&](const TickRecord& r) {
         const double seconds = static_cast<double>(r.tick) / config.tick_rate_hz;
         if (r.kind == TickRecord::Kind::config_change) {
-            if (log) log->append_config_change(serialize_config(r.config));
+            const SimConfig& applied = sh.applied_configs[r.config_slot];
+            if (log) log->append_config_change(serialize_config(applied));
             fmt::print(o.out, "[{:6.1f} s] config: applied before tick {}: {}\n", seconds, r.tick,
-                       config_diff(logged_config, r.config));
-            logged_config = r.config;
+                       config_diff(logged_config, applied));
+            logged_config = applied;
             return;
         }
         result.ticks = r.tick;

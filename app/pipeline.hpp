@@ -53,7 +53,9 @@ struct TickRecord {
     std::array<float, 3> root_position{};
     std::array<float, 2> velocity{};
     float heading = 0.0f;
-    SimConfig config{};           // config_change: the configuration now in force
+    // config_change: the configuration now in force is PipelineShared::applied_configs[config_slot].
+    // (SimConfig holds the terrain's arrays, so it cannot ride in the ring itself.)
+    std::uint32_t config_slot = 0;
 };
 using RecordRing = SpscRing<TickRecord, kRecordRingCapacity>;
 
@@ -89,6 +91,13 @@ struct PipelineShared {
     RecordRing records;
     LatestValue<StateFrame> states;
     LatestValue<ConfigUpdate> config_updates;
+    // Configurations the simulation applied, by change count % kAppliedConfigSlots:
+    // written by the simulation thread before it pushes the config_change record,
+    // read by the writer after popping it. A slot is reused only after
+    // kAppliedConfigSlots further changes, far more than edits arrive in the
+    // writer's few milliseconds of lag.
+    static constexpr std::uint32_t kAppliedConfigSlots = 16;
+    std::array<SimConfig, kAppliedConfigSlots> applied_configs{};
     // Virtual time only: the newest timestamp the input thread has pushed.
     std::atomic<std::int64_t> input_watermark_ns{INT64_MIN};
     std::atomic<bool> input_done{false};
