@@ -181,6 +181,7 @@ void input_thread(PipelineShared& sh, const InputScript& script, std::int64_t t0
         if (script.stamp_when_read) sample.timestamp_ns = monotonic_ns();
         if (sample.connected) writer.push(sample);
         else writer.push_disconnect(sample.timestamp_ns);
+        if (!script.stamp_when_read) sh.input_watermark_ns.store(t0 + event.timestamp_ns, std::memory_order_release);
         sh.counters.samples_pushed.store(writer.pushed(), std::memory_order_relaxed);
         sh.counters.samples_dropped.store(writer.dropped(), std::memory_order_relaxed);
     }
@@ -195,8 +196,11 @@ struct SimulationThreadResult {
     std::uint64_t catch_up_drops = 0;
 };
 
+// `wait_for_input`: every sample up to a tick's time must be in the ring before
+// the tick runs (virtual time, and recordings replayed live, which stay exact
+// even when the input thread is descheduled for a moment).
 void simulation_thread(PipelineShared& sh, SimulationLoop& loop, std::uint64_t total_ticks, std::int64_t t0,
-                       bool virtual_time, SimulationThreadResult& result) {
+                       bool virtual_time, bool wait_for_input, SimulationThreadResult& result) {
     set_simulation_float_mode();
     const SimConfig& config = loop.simulation().config();
     FixedStepDriver driver = FixedStepDriver::at_rate(config.tick_rate_hz, config.max_catch_up_ticks);
@@ -238,7 +242,12 @@ void simulation_thread(PipelineShared& sh, SimulationLoop& loop, std::uint64_t t
             sim_time += driver.dropped_ns - dropped_before;
             sh.counters.catch_up_drops.store(driver.catch_up_cap_hits, std::memory_order_relaxed);
         }
-        for (std::int32_t i = 0; i < due && ticks < total_ticks; ++i) run_one(monotonic_ns());
+        for (std::int32_t i = 0; i < due && ticks < total_ticks; ++i) {
+            while (wait_for_input && sh.input_watermark_ns.load(std::memory_order_acquire) < sim_time + tick_ns &&
+                   !sh.input_done.load(std::memory_order_acquire) && !sh.stop.load(std::memory_order_relaxed))
+                sleep_until_ns(monotonic_ns() + 100'000);  // a sleep, not a spin: the input thread may share our CPU
+            run_one(monotonic_ns());
+        }
     }
     result.catch_up_drops = driver.catch_up_cap_hits;
     sh.simulation_done.store(true, std::memory_order_release);
@@ -413,7 +422,7 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
     ThreadGuard guard{{&sim_thread, &in_thread, &gfx_thread}, sh};
     try {
         sim_thread = std::thread(simulation_thread, std::ref(sh), std::ref(*loop), o.total_ticks, t0, o.virtual_time,
-                                 std::ref(sim_result));
+                                 !o.script.stamp_when_read, std::ref(sim_result));
         in_thread = std::thread(input_thread, std::ref(sh), std::cref(o.script), t0, o.virtual_time);
         gfx_thread = std::thread(render_thread, std::ref(sh), o.frame_rate_hz, t0, o.virtual_time,
                                  std::ref(result.frame_time));
@@ -422,9 +431,12 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
         throw;
     }
     pthread_sigmask(SIG_SETMASK, &previous_mask, nullptr);
-    note_failure(apply_thread_settings(in_thread, "mario-input", config.input_priority, config.input_cpu));
-    note_failure(apply_thread_settings(sim_thread, "mario-sim", config.simulation_priority, config.simulation_cpu));
-    note_failure(apply_thread_settings(gfx_thread, "mario-render", config.render_priority, config.render_cpu));
+    // Virtual time waits by spinning: never under SCHED_FIFO, where a spinning
+    // thread would starve the writer it waits for.
+    const bool fifo = !o.virtual_time;
+    note_failure(apply_thread_settings(in_thread, "mario-input", fifo ? config.input_priority : 0, config.input_cpu));
+    note_failure(apply_thread_settings(sim_thread, "mario-sim", fifo ? config.simulation_priority : 0, config.simulation_cpu));
+    note_failure(apply_thread_settings(gfx_thread, "mario-render", fifo ? config.render_priority : 0, config.render_cpu));
     if (!realtime_failed.empty()) {
         result.realtime_warning = realtime_failed;
         fmt::print(o.err, "warning: real-time settings not permitted ({}); running with normal scheduling\n",
@@ -451,7 +463,13 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
             return;
         }
         result.ticks = r.tick;
-        if (log) log->append_tick(r.input);
+        if (log) {
+            log->append_tick(r.input);
+            if (log->pending_ticks() >= flush_ticks) {
+                log->flush();  // a chunk per 250 ms of ticks: kill -9 loses at most that
+                last_flush = monotonic_ns();
+            }
+        }
         const vec3 root(r.root_position[0], r.root_position[1], r.root_position[2]);
         if (trace && std::fputs(trace_csv_row(r.tick, r.hash, root).c_str(), trace.get()) < 0)
             throw std::runtime_error(o.trace_file + ": write failed");
@@ -485,8 +503,10 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
         const bool finished = sh.simulation_done.load(std::memory_order_acquire);
         while (sh.records.try_pop(record)) handle(record);
         const std::int64_t now = monotonic_ns();
-        if (log && log->pending_ticks() > 0 && (log->pending_ticks() >= flush_ticks || now - last_flush >= 200'000'000)) {
-            log->flush();  // a chunk at least every 250 ms: kill -9 loses at most that
+        // And by the clock, should ticks come slowly; virtual time flushes by tick
+        // count only, so its logs are byte-for-byte repeatable.
+        if (log && !o.virtual_time && log->pending_ticks() > 0 && now - last_flush >= 200'000'000) {
+            log->flush();
             last_flush = now;
         }
         if (finished) break;  // simulation_done was read before the last drain
