@@ -488,11 +488,13 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
             const PipelineCounters& c = sh.counters;
             fmt::print(o.out,
                        "[{:6.1f} s] {:<8} {:4.2f} m/s  heading {:4.0f}°  at ({:6.2f}, {:6.2f})  walked {:5.1f} m | "
-                       "tick max {:.0f} µs  input→tick max {:.1f} ms  frames {} (missed {})  dropped {}{}\n",
+                       "tick max {:.0f} µs  input→tick max {:.1f} ms  frame max {:.0f} µs  frames {} (missed {})  "
+                       "dropped {}{}\n",
                        seconds, connected ? activity(speed) : "idle", speed, r.heading * det::kRadToDeg,
                        root.x, root.z, result.distance_m,
                        c.tick_time_max_ns.load(std::memory_order_relaxed) / 1e3,
                        c.input_latency_max_ns.load(std::memory_order_relaxed) / 1e6,
+                       c.frame_time_max_ns.load(std::memory_order_relaxed) / 1e3,
                        c.frames.load(std::memory_order_relaxed), c.missed_frames.load(std::memory_order_relaxed),
                        c.samples_dropped.load(std::memory_order_relaxed), connected ? "" : "  [no controller]");
             std::fflush(o.out);

@@ -6,6 +6,8 @@
 // It is its own executable because the replacement is process-wide.
 #include <catch2/catch.hpp>
 
+#include <pthread.h>
+
 #include <atomic>
 #include <cstdlib>
 #include <new>
@@ -17,8 +19,14 @@
 namespace {
 std::atomic<bool> g_counting{false};
 std::atomic<std::uint64_t> g_allocations{0};
+// While set, only allocations made by threads other than this one are counted
+// (the pipeline's workers, while the test's thread is the writer).
+std::atomic<bool> g_workers_only{false};
+std::atomic<pthread_t> g_writer_thread{};
 void note_allocation() {
-    if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+    if (!g_counting.load(std::memory_order_relaxed)) return;
+    if (g_workers_only.load(std::memory_order_relaxed) && pthread_equal(pthread_self(), g_writer_thread.load())) return;
+    g_allocations.fetch_add(1, std::memory_order_relaxed);
 }
 void* allocate(std::size_t n, std::size_t align) {
     note_allocation();
@@ -160,4 +168,32 @@ TEST_CASE("10 000 ticks and 1 000 frames after warm-up allocate nothing", "[zero
     CHECK(frames.has_state());
     CHECK(writer.dropped() == 0);
     CHECK(std::isfinite(sink.x));
+}
+
+TEST_CASE("the pipeline's input, simulation and render threads allocate nothing in a whole run", "[zero_alloc]") {
+    // The real threads of run_pipeline, from their start to their end; the
+    // writer (this thread) may allocate (it formats text and writes files).
+    for (const bool virtual_time : {true, false}) {
+        INFO((virtual_time ? "virtual time" : "real time"));
+        PipelineOptions o;
+        o.config = default_config();
+        o.script = script_from_program(load_program("builtin:walk_stop"), kSimulatedControllerHz, {{0.5, 0.25}});
+        o.total_ticks = virtual_time ? 1620 : 240;  // the whole program, or one real second
+        o.virtual_time = virtual_time;
+        o.status_lines = false;
+        std::FILE* out = std::tmpfile();
+        o.out = out;
+        g_writer_thread = pthread_self();
+        g_allocations = 0;
+        g_workers_only = true;
+        g_counting = true;
+        const PipelineResult r = run_pipeline(o);
+        g_counting = false;
+        g_workers_only = false;
+        std::fclose(out);
+        CHECK(g_allocations.load() == 0);
+        CHECK(r.ticks == o.total_ticks);
+        CHECK(r.frames > 0);
+        CHECK(r.disconnects == 1);
+    }
 }
