@@ -26,13 +26,16 @@ SimulationLoop::SimulationLoop(const SimConfig& config, PipelineShared& shared,
                                std::vector<ScheduledConfigChange> scheduled, bool wait_when_full)
     : sim_(config), shared_(shared), scheduled_(std::move(scheduled)), wait_when_full_(wait_when_full) {}
 
-void SimulationLoop::apply(const SimConfig& config) {
+void SimulationLoop::apply(const SimConfig& config, TickRecord::ConfigSource source, std::uint32_t id) {
     // The watcher refused structural changes already, and a log's changes were
-    // checked when it was decoded, so retune cannot fail here.
+    // checked when it was decoded, so retune cannot fail here. It copies the
+    // configuration into the simulation's; the terrain is structural, so its
+    // arrays have the same sizes and the copy reuses their storage.
     if (!sim_.retune(config).empty()) return;
     ++config_changes_;
     record_.kind = TickRecord::Kind::config_change;
-    record_.config = config;
+    record_.config_source = source;
+    record_.config_id = id;
     push(record_);
 }
 
@@ -50,9 +53,14 @@ void SimulationLoop::push(const TickRecord& record) {
 void SimulationLoop::run_tick(std::int64_t tick_time_ns, std::int64_t now_ns) {
     // Tick boundary: configuration changes first, so the log can place them.
     const std::uint64_t k = sim_.state().tick;
-    while (next_scheduled_ < scheduled_.size() && scheduled_[next_scheduled_].before_tick <= k)
-        apply(scheduled_[next_scheduled_++].config);
-    if (shared_.config_updates.take()) apply(shared_.config_updates.front().config);
+    while (next_scheduled_ < scheduled_.size() && scheduled_[next_scheduled_].before_tick <= k) {
+        apply(scheduled_[next_scheduled_].config, TickRecord::ConfigSource::recorded,
+              static_cast<std::uint32_t>(next_scheduled_));
+        ++next_scheduled_;
+    }
+    if (shared_.config_updates.take())
+        apply(shared_.config_updates.front().config, TickRecord::ConfigSource::live_edit,
+              shared_.config_updates.front().version);
 
     // The oldest sample due has waited longest: it is this tick's worst latency.
     if (const TimedInput* oldest = shared_.input_ring.peek(); oldest && oldest->timestamp_ns <= tick_time_ns)
@@ -335,6 +343,9 @@ struct LiveTuning {
     std::unique_ptr<ConfigWatcher> watcher;
     SimConfig published;       // the newest configuration handed over
     std::uint32_t version = 0;
+    // Every configuration handed over, by version − 1: the simulation names the
+    // one it applied and the writer logs it (edits come at human pace).
+    std::vector<SimConfig> history;
     std::int64_t dirty_since = -1;
 
     void reload(PipelineShared& sh, std::FILE* err) {
@@ -354,6 +365,7 @@ struct LiveTuning {
         }
         if (serialize_config(next) == serialize_config(published)) return;
         published = next;
+        history.push_back(next);
         ConfigUpdate& update = sh.config_updates.back();
         update.version = ++version;
         update.config = next;
@@ -456,10 +468,13 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
     auto handle = [&](const TickRecord& r) {
         const double seconds = static_cast<double>(r.tick) / config.tick_rate_hz;
         if (r.kind == TickRecord::Kind::config_change) {
-            if (log) log->append_config_change(serialize_config(r.config));
+            const SimConfig& applied = r.config_source == TickRecord::ConfigSource::recorded
+                                           ? o.scheduled_changes.at(r.config_id).config
+                                           : tuning.history.at(r.config_id - 1);
+            if (log) log->append_config_change(serialize_config(applied));
             fmt::print(o.out, "[{:6.1f} s] config: applied before tick {}: {}\n", seconds, r.tick,
-                       config_diff(logged_config, r.config));
-            logged_config = r.config;
+                       config_diff(logged_config, applied));
+            logged_config = applied;
             return;
         }
         result.ticks = r.tick;

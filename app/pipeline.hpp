@@ -53,7 +53,12 @@ struct TickRecord {
     std::array<float, 3> root_position{};
     std::array<float, 2> velocity{};
     float heading = 0.0f;
-    SimConfig config{};           // config_change: the configuration now in force
+    // config_change: which configuration is now in force. The configuration itself
+    // (it owns the terrain's arrays) stays with the writer, who made or read it:
+    // a live edit by its version, a recorded change by its index.
+    enum class ConfigSource : std::uint8_t { live_edit, recorded };
+    ConfigSource config_source = ConfigSource::live_edit;
+    std::uint32_t config_id = 0;
 };
 using RecordRing = SpscRing<TickRecord, kRecordRingCapacity>;
 
@@ -114,7 +119,7 @@ public:
     std::uint64_t config_changes() const { return config_changes_; }
 
 private:
-    void apply(const SimConfig& config);
+    void apply(const SimConfig& config, TickRecord::ConfigSource source, std::uint32_t id);
     void push(const TickRecord& record);
 
     Simulation sim_;

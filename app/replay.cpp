@@ -78,7 +78,8 @@ ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name,
     if (options.keep_tick_hashes) result.tick_hashes.reserve(log.ticks.size());
     size_t next_change = 0;
     vec3 previous_root = sim.state().root_position;
-    for (size_t k = 0; k < log.ticks.size(); ++k) {
+    bool keep_going = !options.on_tick || options.on_tick(sim);
+    for (size_t k = 0; k < log.ticks.size() && keep_going; ++k) {
         while (next_change < log.config_changes.size() && log.config_changes[next_change].before_tick <= k) {
             const SimConfig next = apply_config_text(sim.config(), log.config_changes[next_change].config_text,
                                                      fmt::format("{} (config change before tick {})", log_name, k));
@@ -93,6 +94,7 @@ ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name,
         result.distance_m += std::sqrt(static_cast<double>(d.x) * d.x + static_cast<double>(d.z) * d.z);
         previous_root = s.root_position;
         if (options.keep_tick_hashes) result.tick_hashes.push_back(hash_state(s));
+        if (options.on_tick) keep_going = options.on_tick(sim);
         if (trace) write(trace, trace_csv_row(s), options.trace_csv);
         if (joints) {
             std::string row = fmt::format("{}", s.tick);
@@ -107,7 +109,7 @@ ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name,
                                           s.local_translations.begin() + static_cast<std::ptrdiff_t>(joint_count));
         }
     }
-    result.ticks = log.ticks.size();
+    result.ticks = sim.state().tick;  // fewer than the log holds when on_tick stopped early
     result.final_hash = hash_state(sim.state());
     result.duration_s = static_cast<double>(result.ticks) / config.tick_rate_hz;
     result.final_root_position = sim.state().root_position;

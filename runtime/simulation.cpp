@@ -39,7 +39,7 @@ void set_simulation_float_mode() {
 #endif
 }
 
-Simulation::Simulation(const SimConfig& config) : config_(config) {
+Simulation::Simulation(const SimConfig& config, const Terrain& terrain) : config_(config), terrain_(terrain) {
     if (config_.tick_rate_hz <= 0) throw std::invalid_argument("tick_rate_hz must be positive");
     const Skeleton skeleton = make_puppet_skeleton(config_);
     if (skeleton.joint_count() > kMaxJoints) throw std::invalid_argument("puppet has too many joints");
@@ -63,6 +63,7 @@ std::string structural_change(const SimConfig& c, const SimConfig& next) {
         &SimConfig::upper_arm_length, &SimConfig::forearm_length, &SimConfig::hand_length};
     for (auto field : structural)
         if (next.*field != c.*field) return "puppet (skeleton proportions)";
+    if (!(next.terrain == c.terrain)) return "terrain";
     return {};
 }
 
