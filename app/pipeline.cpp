@@ -26,15 +26,16 @@ SimulationLoop::SimulationLoop(const SimConfig& config, PipelineShared& shared,
                                std::vector<ScheduledConfigChange> scheduled, bool wait_when_full)
     : sim_(config), shared_(shared), scheduled_(std::move(scheduled)), wait_when_full_(wait_when_full) {}
 
-void SimulationLoop::apply(const SimConfig& config) {
+void SimulationLoop::apply(const SimConfig& config, TickRecord::ConfigSource source, std::uint32_t id) {
     // The watcher refused structural changes already, and a log's changes were
-    // checked when it was decoded, so retune cannot fail here.
+    // checked when it was decoded, so retune cannot fail here. It copies the
+    // configuration into the simulation's; the terrain is structural, so its
+    // arrays have the same sizes and the copy reuses their storage.
     if (!sim_.retune(config).empty()) return;
-    const auto slot = static_cast<std::uint32_t>(config_changes_ % PipelineShared::kAppliedConfigSlots);
     ++config_changes_;
-    shared_.applied_configs[slot] = config;  // a live edit may allocate here: not the steady state
     record_.kind = TickRecord::Kind::config_change;
-    record_.config_slot = slot;
+    record_.config_source = source;
+    record_.config_id = id;
     push(record_);
 }
 
@@ -52,9 +53,14 @@ void SimulationLoop::push(const TickRecord& record) {
 void SimulationLoop::run_tick(std::int64_t tick_time_ns, std::int64_t now_ns) {
     // Tick boundary: configuration changes first, so the log can place them.
     const std::uint64_t k = sim_.state().tick;
-    while (next_scheduled_ < scheduled_.size() && scheduled_[next_scheduled_].before_tick <= k)
-        apply(scheduled_[next_scheduled_++].config);
-    if (shared_.config_updates.take()) apply(shared_.config_updates.front().config);
+    while (next_scheduled_ < scheduled_.size() && scheduled_[next_scheduled_].before_tick <= k) {
+        apply(scheduled_[next_scheduled_].config, TickRecord::ConfigSource::recorded,
+              static_cast<std::uint32_t>(next_scheduled_));
+        ++next_scheduled_;
+    }
+    if (shared_.config_updates.take())
+        apply(shared_.config_updates.front().config, TickRecord::ConfigSource::live_edit,
+              shared_.config_updates.front().version);
 
     // The oldest sample due has waited longest: it is this tick's worst latency.
     if (const TimedInput* oldest = shared_.input_ring.peek(); oldest && oldest->timestamp_ns <= tick_time_ns)
@@ -183,6 +189,7 @@ void input_thread(PipelineShared& sh, const InputScript& script, std::int64_t t0
         if (script.stamp_when_read) sample.timestamp_ns = monotonic_ns();
         if (sample.connected) writer.push(sample);
         else writer.push_disconnect(sample.timestamp_ns);
+        if (!script.stamp_when_read) sh.input_watermark_ns.store(t0 + event.timestamp_ns, std::memory_order_release);
         sh.counters.samples_pushed.store(writer.pushed(), std::memory_order_relaxed);
         sh.counters.samples_dropped.store(writer.dropped(), std::memory_order_relaxed);
     }
@@ -197,8 +204,11 @@ struct SimulationThreadResult {
     std::uint64_t catch_up_drops = 0;
 };
 
+// `wait_for_input`: every sample up to a tick's time must be in the ring before
+// the tick runs (virtual time, and recordings replayed live, which stay exact
+// even when the input thread is descheduled for a moment).
 void simulation_thread(PipelineShared& sh, SimulationLoop& loop, std::uint64_t total_ticks, std::int64_t t0,
-                       bool virtual_time, SimulationThreadResult& result) {
+                       bool virtual_time, bool wait_for_input, SimulationThreadResult& result) {
     set_simulation_float_mode();
     const SimConfig& config = loop.simulation().config();
     FixedStepDriver driver = FixedStepDriver::at_rate(config.tick_rate_hz, config.max_catch_up_ticks);
@@ -240,7 +250,12 @@ void simulation_thread(PipelineShared& sh, SimulationLoop& loop, std::uint64_t t
             sim_time += driver.dropped_ns - dropped_before;
             sh.counters.catch_up_drops.store(driver.catch_up_cap_hits, std::memory_order_relaxed);
         }
-        for (std::int32_t i = 0; i < due && ticks < total_ticks; ++i) run_one(monotonic_ns());
+        for (std::int32_t i = 0; i < due && ticks < total_ticks; ++i) {
+            while (wait_for_input && sh.input_watermark_ns.load(std::memory_order_acquire) < sim_time + tick_ns &&
+                   !sh.input_done.load(std::memory_order_acquire) && !sh.stop.load(std::memory_order_relaxed))
+                sleep_until_ns(monotonic_ns() + 100'000);  // a sleep, not a spin: the input thread may share our CPU
+            run_one(monotonic_ns());
+        }
     }
     result.catch_up_drops = driver.catch_up_cap_hits;
     sh.simulation_done.store(true, std::memory_order_release);
@@ -328,6 +343,9 @@ struct LiveTuning {
     std::unique_ptr<ConfigWatcher> watcher;
     SimConfig published;       // the newest configuration handed over
     std::uint32_t version = 0;
+    // Every configuration handed over, by version − 1: the simulation names the
+    // one it applied and the writer logs it (edits come at human pace).
+    std::vector<SimConfig> history;
     std::int64_t dirty_since = -1;
 
     void reload(PipelineShared& sh, std::FILE* err) {
@@ -347,6 +365,7 @@ struct LiveTuning {
         }
         if (serialize_config(next) == serialize_config(published)) return;
         published = next;
+        history.push_back(next);
         ConfigUpdate& update = sh.config_updates.back();
         update.version = ++version;
         update.config = next;
@@ -415,7 +434,7 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
     ThreadGuard guard{{&sim_thread, &in_thread, &gfx_thread}, sh};
     try {
         sim_thread = std::thread(simulation_thread, std::ref(sh), std::ref(*loop), o.total_ticks, t0, o.virtual_time,
-                                 std::ref(sim_result));
+                                 !o.script.stamp_when_read, std::ref(sim_result));
         in_thread = std::thread(input_thread, std::ref(sh), std::cref(o.script), t0, o.virtual_time);
         gfx_thread = std::thread(render_thread, std::ref(sh), o.frame_rate_hz, t0, o.virtual_time,
                                  std::ref(result.frame_time));
@@ -424,9 +443,12 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
         throw;
     }
     pthread_sigmask(SIG_SETMASK, &previous_mask, nullptr);
-    note_failure(apply_thread_settings(in_thread, "mario-input", config.input_priority, config.input_cpu));
-    note_failure(apply_thread_settings(sim_thread, "mario-sim", config.simulation_priority, config.simulation_cpu));
-    note_failure(apply_thread_settings(gfx_thread, "mario-render", config.render_priority, config.render_cpu));
+    // Virtual time waits by spinning: never under SCHED_FIFO, where a spinning
+    // thread would starve the writer it waits for.
+    const bool fifo = !o.virtual_time;
+    note_failure(apply_thread_settings(in_thread, "mario-input", fifo ? config.input_priority : 0, config.input_cpu));
+    note_failure(apply_thread_settings(sim_thread, "mario-sim", fifo ? config.simulation_priority : 0, config.simulation_cpu));
+    note_failure(apply_thread_settings(gfx_thread, "mario-render", fifo ? config.render_priority : 0, config.render_cpu));
     if (!realtime_failed.empty()) {
         result.realtime_warning = realtime_failed;
         fmt::print(o.err, "warning: real-time settings not permitted ({}); running with normal scheduling\n",
@@ -446,7 +468,9 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
     auto handle = [&](const TickRecord& r) {
         const double seconds = static_cast<double>(r.tick) / config.tick_rate_hz;
         if (r.kind == TickRecord::Kind::config_change) {
-            const SimConfig& applied = sh.applied_configs[r.config_slot];
+            const SimConfig& applied = r.config_source == TickRecord::ConfigSource::recorded
+                                           ? o.scheduled_changes.at(r.config_id).config
+                                           : tuning.history.at(r.config_id - 1);
             if (log) log->append_config_change(serialize_config(applied));
             fmt::print(o.out, "[{:6.1f} s] config: applied before tick {}: {}\n", seconds, r.tick,
                        config_diff(logged_config, applied));
@@ -454,7 +478,13 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
             return;
         }
         result.ticks = r.tick;
-        if (log) log->append_tick(r.input);
+        if (log) {
+            log->append_tick(r.input);
+            if (log->pending_ticks() >= flush_ticks) {
+                log->flush();  // a chunk per 250 ms of ticks: kill -9 loses at most that
+                last_flush = monotonic_ns();
+            }
+        }
         const vec3 root(r.root_position[0], r.root_position[1], r.root_position[2]);
         if (trace && std::fputs(trace_csv_row(r.tick, r.hash, root).c_str(), trace.get()) < 0)
             throw std::runtime_error(o.trace_file + ": write failed");
@@ -473,11 +503,13 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
             const PipelineCounters& c = sh.counters;
             fmt::print(o.out,
                        "[{:6.1f} s] {:<8} {:4.2f} m/s  heading {:4.0f}°  at ({:6.2f}, {:6.2f})  walked {:5.1f} m | "
-                       "tick max {:.0f} µs  input→tick max {:.1f} ms  frames {} (missed {})  dropped {}{}\n",
+                       "tick max {:.0f} µs  input→tick max {:.1f} ms  frame max {:.0f} µs  frames {} (missed {})  "
+                       "dropped {}{}\n",
                        seconds, connected ? activity(speed) : "idle", speed, r.heading * det::kRadToDeg,
                        root.x, root.z, result.distance_m,
                        c.tick_time_max_ns.load(std::memory_order_relaxed) / 1e3,
                        c.input_latency_max_ns.load(std::memory_order_relaxed) / 1e6,
+                       c.frame_time_max_ns.load(std::memory_order_relaxed) / 1e3,
                        c.frames.load(std::memory_order_relaxed), c.missed_frames.load(std::memory_order_relaxed),
                        c.samples_dropped.load(std::memory_order_relaxed), connected ? "" : "  [no controller]");
             std::fflush(o.out);
@@ -488,8 +520,10 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
         const bool finished = sh.simulation_done.load(std::memory_order_acquire);
         while (sh.records.try_pop(record)) handle(record);
         const std::int64_t now = monotonic_ns();
-        if (log && log->pending_ticks() > 0 && (log->pending_ticks() >= flush_ticks || now - last_flush >= 200'000'000)) {
-            log->flush();  // a chunk at least every 250 ms: kill -9 loses at most that
+        // And by the clock, should ticks come slowly; virtual time flushes by tick
+        // count only, so its logs are byte-for-byte repeatable.
+        if (log && !o.virtual_time && log->pending_ticks() > 0 && now - last_flush >= 200'000'000) {
+            log->flush();
             last_flush = now;
         }
         if (finished) break;  // simulation_done was read before the last drain

@@ -53,9 +53,12 @@ struct TickRecord {
     std::array<float, 3> root_position{};
     std::array<float, 2> velocity{};
     float heading = 0.0f;
-    // config_change: the configuration now in force is PipelineShared::applied_configs[config_slot].
-    // (SimConfig holds the terrain's arrays, so it cannot ride in the ring itself.)
-    std::uint32_t config_slot = 0;
+    // config_change: which configuration is now in force. The configuration itself
+    // (it owns the terrain's arrays) stays with the writer, who made or read it:
+    // a live edit by its version, a recorded change by its index.
+    enum class ConfigSource : std::uint8_t { live_edit, recorded };
+    ConfigSource config_source = ConfigSource::live_edit;
+    std::uint32_t config_id = 0;
 };
 using RecordRing = SpscRing<TickRecord, kRecordRingCapacity>;
 
@@ -91,13 +94,6 @@ struct PipelineShared {
     RecordRing records;
     LatestValue<StateFrame> states;
     LatestValue<ConfigUpdate> config_updates;
-    // Configurations the simulation applied, by change count % kAppliedConfigSlots:
-    // written by the simulation thread before it pushes the config_change record,
-    // read by the writer after popping it. A slot is reused only after
-    // kAppliedConfigSlots further changes, far more than edits arrive in the
-    // writer's few milliseconds of lag.
-    static constexpr std::uint32_t kAppliedConfigSlots = 16;
-    std::array<SimConfig, kAppliedConfigSlots> applied_configs{};
     // Virtual time only: the newest timestamp the input thread has pushed.
     std::atomic<std::int64_t> input_watermark_ns{INT64_MIN};
     std::atomic<bool> input_done{false};
@@ -123,7 +119,7 @@ public:
     std::uint64_t config_changes() const { return config_changes_; }
 
 private:
-    void apply(const SimConfig& config);
+    void apply(const SimConfig& config, TickRecord::ConfigSource source, std::uint32_t id);
     void push(const TickRecord& record);
 
     Simulation sim_;
