@@ -61,6 +61,19 @@ bool is_local_minimum(float v, std::int32_t i, std::int32_t j, int h, double thr
 
 }  // namespace
 
+std::vector<std::pair<std::int32_t, std::int32_t>> local_minima(std::span<const float> m, std::int32_t rows,
+                                                               std::int32_t cols, int h, double threshold) {
+    const auto at = [&](std::int32_t i, std::int32_t j) -> float {
+        if (i < 0 || j < 0 || i >= rows || j >= cols) return kPairInvalid;
+        return m[static_cast<size_t>(i) * static_cast<size_t>(cols) + static_cast<size_t>(j)];
+    };
+    std::vector<std::pair<std::int32_t, std::int32_t>> out;
+    for (std::int32_t i = 0; i < rows; ++i)
+        for (std::int32_t j = 0; j < cols; ++j)
+            if (is_local_minimum(at(i, j), i, j, h, threshold, at)) out.push_back({i, j});
+    return out;
+}
+
 std::vector<vec3> database_positions(const ClipDatabase& db) {
     const size_t joints = static_cast<size_t>(db.skeleton.joint_count());
     std::vector<vec3> out(static_cast<size_t>(db.frame_count()) * joints);

@@ -91,6 +91,13 @@ CandidateSearchResult find_transition_candidates_reference(const ClipDatabase& d
                                                            const FrameFeatures& features, double scale,
                                                            const CandidateSearchOptions& options);
 
+// The local-minimum rule on a dense row-major matrix (values < 0 mark cells no
+// minimum may touch, values ≥ kPairInvalid are absent): cells below the threshold,
+// strictly below every earlier neighbour in raster order and not above any later
+// one within ±h. The tiled search applies the same rule per tile.
+std::vector<std::pair<std::int32_t, std::int32_t>> local_minima(std::span<const float> matrix, std::int32_t rows,
+                                                               std::int32_t cols, int h, double threshold);
+
 // Distance at a percentile (0–100) of all valid pairs: exact when there are at
 // most `max_samples` pairs, else over a deterministic sample of that many.
 std::vector<double> distance_percentiles(const FrameFeatures& features, const std::vector<double>& percentiles,
