@@ -18,5 +18,6 @@ inline void on_parsed(CLI::App* command, int& exit_code, std::function<int()> ac
 void register_run_command(CLI::App& app, int& exit_code);
 void register_log_commands(CLI::App& app, int& exit_code);   // record, replay
 void register_clip_commands(CLI::App& app, int& exit_code);  // clip info, clip fk
+void register_gait_eval_command(CLI::App& app, int& exit_code);  // gait-eval
 
 }  // namespace marionette

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
     register_run_command(app, exit_code);
     register_log_commands(app, exit_code);
     register_clip_commands(app, exit_code);
+    register_gait_eval_command(app, exit_code);
 
     try {
         app.parse(argc, argv);
