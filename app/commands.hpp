@@ -9,6 +9,7 @@ struct RunOptions {
     std::string config_file;
     std::string input = "sim:builtin:demo";  // sim:PROGRAM (a file, or builtin:NAME)
     std::string display = "auto";
+    std::string render_config_file;          // render settings (config/render.toml overrides)
     std::string record_file;
     std::string trace_file;
     double duration_s = -1.0;                // < 0: until the program ends

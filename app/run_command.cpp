@@ -13,6 +13,7 @@
 #include "app/commands.hpp"
 #include "app/config.hpp"
 #include "app/files.hpp"
+#include "app/live_view.hpp"
 #include "app/program_source.hpp"
 #include "app/replay.hpp"
 #include "runtime/fixed_step.hpp"
@@ -41,19 +42,21 @@ int run_command(const RunOptions& o) {
     const SimConfig config = load_config(o.config_file);
     if (o.input.rfind("sim:", 0) != 0)
         throw ImportError(o.input, 0, "only the simulated controller (--input sim:PROGRAM) is available in this build");
-    if (o.display != "auto" && o.display != "headless")
-        throw ImportError(o.display, 0, "only --display headless (or auto) is available in this build");
     const StickProgram program = load_program(o.input.substr(4));
     std::vector<TickInput> ticks = render_stick_program(program, config.tick_rate_hz);
     std::uint64_t total_ticks = ticks.size();
     if (o.duration_s >= 0.0) total_ticks = static_cast<std::uint64_t>(o.duration_s * config.tick_rate_hz + 0.5);
 
-    fmt::print("marionette: headless run, simulated controller playing '{}' ({:.1f} s) at {} Hz\n", program.name,
+    fmt::print("marionette: run, simulated controller playing '{}' ({:.1f} s) at {} Hz\n", program.name,
                static_cast<double>(total_ticks) / config.tick_rate_hz, config.tick_rate_hz);
     std::fflush(stdout);
 
     set_simulation_float_mode();
     Simulation sim(config);
+    // A window or KMS display when --display (or auto) picks one; nullptr: console only.
+    std::unique_ptr<LiveView> live = LiveView::open(o.display, o.render_config_file, sim);
+    if (live) fmt::print("display: {}\n", live->description());
+    PuppetState previous = sim.state();
     std::unique_ptr<InputLogFile> log;
     if (!o.record_file.empty()) {
         InputLogHeader header;
@@ -91,6 +94,7 @@ int run_command(const RunOptions& o) {
         for (std::int32_t i = 0; i < due && k < total_ticks; ++i, ++k) {
             const TickInput input = k < ticks.size() ? ticks[k] : TickInput{};
             const vec3 before = sim.state().root_position;
+            if (live) previous = sim.state();
             sim.step(input);
             const PuppetState& s = sim.state();
             const vec3 d = s.root_position - before;
@@ -106,6 +110,9 @@ int run_command(const RunOptions& o) {
                 std::fflush(stdout);
             }
         }
+        if (live && !live->frame(previous, sim.state(), static_cast<float>(driver.alpha()),
+                                 status_line(sim.state(), static_cast<double>(sim.state().tick) / config.tick_rate_hz, distance)))
+            g_stop_requested.store(true);  // window closed
         if (!o.fast) {
             const auto next = last + std::chrono::nanoseconds(driver.tick_ns - driver.accumulated_ns);
             std::this_thread::sleep_until(next);
@@ -124,7 +131,9 @@ void register_run_command(CLI::App& app, int& exit_code) {
     CLI::App* cmd = app.add_subcommand("run", "Run the puppet live (headless demo with a simulated controller by default)");
     cmd->add_option("--config", o->config_file, "TOML file overriding the defaults")->check(CLI::ExistingFile);
     cmd->add_option("--input", o->input, "sim:PROGRAM (a stick program file, or builtin:NAME)");
-    cmd->add_option("--display", o->display, "auto|headless")->check(CLI::IsMember({"auto", "headless", "kms", "window"}));
+    cmd->add_option("--render-config", o->render_config_file, "render settings TOML overriding config/render.toml")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--display", o->display, "auto|headless|window|kms (auto: a window under X11/Wayland, KMS on a console, else none)")->check(CLI::IsMember({"auto", "headless", "kms", "window"}));
     cmd->add_option("--record", o->record_file, "write the input log here");
     cmd->add_option("--trace", o->trace_file, "per-tick CSV: tick,hash,root_x,root_y,root_z");
     cmd->add_option("--duration", o->duration_s, "seconds to run (default: until the program ends)")->check(CLI::Range(0.0, 86400.0));

@@ -210,3 +210,23 @@ TEST_CASE("a frame allocates nothing once the view is open", "[render][alloc]") 
         for (const PuppetState& s : r.states) view.frame(s, overlay, "tick 123  speed 1.00 m/s", 1.0f / 60.0f);
     CHECK(test::allocation_count() - before == 0);
 }
+
+// Hidden from test discovery ([.window]): CTest runs it under xvfb-run (see
+// tests/CMakeLists.txt), where the SDL window platform must draw exactly what the
+// headless one draws.
+TEST_CASE("the SDL window platform draws the golden frame under Xvfb", "[.window]") {
+    REQUIRE(std::getenv("DISPLAY") != nullptr);
+    const Replayed r = replay_ticks("walk_stop", {600});
+    render::RenderSettings settings = load_render_config("").settings;
+    settings.show_hud = false;
+    render::PlatformOptions options = golden_platform();
+    options.kind = render::PlatformKind::window;
+    render::View view(options, settings, r.skeleton, Terrain{});
+    INFO(view.platform().description());
+    REQUIRE(view.platform().width() == kGoldenWidth);
+    REQUIRE(view.platform().height() == kGoldenHeight);
+    const render::FrameResult result = view.frame(r.states[0], render::DebugOverlay{}, "", 1.0f / 60.0f);
+    CHECK(result.present == render::PresentResult::ok);
+    CHECK_FALSE(result.events.close_requested);
+    check_golden("walk_stop_t600", snapshot(view));
+}
