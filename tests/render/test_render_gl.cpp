@@ -7,6 +7,7 @@
 // (it runs this program with MARIONETTE_UPDATE_RENDER_GOLDEN=1) and look at them.
 #include <catch2/catch.hpp>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 
@@ -159,6 +160,26 @@ TEST_CASE("the HUD draws text into the top-left corner", "[render][hud]") {
             const std::size_t i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(with.width) + static_cast<std::size_t>(x)) * 4;
             if (d.diff.rgba[i] == 255 && d.diff.rgba[i + 1] == 0) REQUIRE((x < 80 && y < 24));
         }
+}
+
+TEST_CASE("the motion-graph overlay writes the current clip and next transition when toggled on", "[render][hud]") {
+    const Replayed r = replay_ticks("stand_still", {10});
+    render::View view(golden_platform(), render::RenderSettings{}, r.skeleton, Terrain{});
+    render::DebugOverlay overlay;
+    overlay.motion_graph.valid = true;
+    std::snprintf(overlay.motion_graph.current_clip.data(), overlay.motion_graph.current_clip.size(), "walk");
+    std::snprintf(overlay.motion_graph.next_transition.data(), overlay.motion_graph.next_transition.size(), "run");
+    overlay.motion_graph.transition_progress = 0.4f;
+    view.frame(r.states[0], overlay, "", 0.0f);
+    const render::Image off = snapshot(view);
+    view.renderer().toggles().motion_graph = true;
+    view.frame(r.states[0], overlay, "", 0.0f);
+    const render::Image on = snapshot(view);
+    const render::ImageDifference d = render::compare_images(off, on, 8);
+    CHECK(d.differing_pixels > 50);
+    view.renderer().toggles().hud = false;  // the HUD toggle does not hide the motion-graph line
+    view.frame(r.states[0], overlay, "ignored", 0.0f);
+    CHECK(render::compare_images(on, snapshot(view), 0).differing_pixels == 0);
 }
 
 TEST_CASE("shader compile and link errors name the shader and carry its log", "[render][shader]") {
