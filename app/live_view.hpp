@@ -1,10 +1,11 @@
 #pragma once
-// The renderer inside `marionette run` (window or KMS display): opens the
-// platform `--display` names (auto picks one, render_es/platform.hpp), and on each
-// loop pass draws the state interpolated between the last two ticks when a
-// display refresh is due. Until the pipeline issue moves it to its own thread it
-// runs on the simulation's thread between ticks.
-#include <chrono>
+// The display `marionette run` draws on (window or KMS): opened on the main thread
+// (so a failure is an ordinary error with its exit code), then handed to the
+// pipeline's render thread (app/pipeline.hpp), which calls frame() once per
+// display refresh with the two latest ticks and the interpolation alpha. Closing
+// the window (or Esc) sets the run's stop flag, as Ctrl-C does.
+#include <array>
+#include <atomic>
 #include <memory>
 #include <string>
 
@@ -17,13 +18,17 @@ namespace marionette {
 class LiveView {
 public:
     // display: auto|headless|window|kms. Returns nullptr when the choice is headless
-    // (no display: the run stays a console program). Throws render::PlatformError.
+    // (no display: the run stays a console program). Throws render::PlatformError,
+    // render::ShaderError, ConfigError.
     static std::unique_ptr<LiveView> open(const std::string& display, const std::string& render_config_file,
-                                          const Simulation& sim);
+                                          const SimConfig& config, std::atomic<bool>* stop_flag);
+    ~LiveView();
 
-    // Draws previous→current at alpha when a frame is due; false once the user
-    // closed the window (or pressed Esc).
-    bool frame(const PuppetState& previous, const PuppetState& current, float alpha, const std::string& hud);
+    // Draws previous→current at alpha with a status HUD; handles the window's keys
+    // (overlays, screenshot) and close. No allocation (unless a screenshot is taken).
+    void frame(const PuppetState& previous, const PuppetState& current, float alpha);
+    // Called by the render thread when it ends, so the main thread can free the context.
+    void release_thread() { view_->platform().release_current(); }
 
     std::string description() { return view_->platform().description(); }
     std::uint64_t frames() const { return frames_; }
@@ -31,13 +36,15 @@ public:
 private:
     LiveView() = default;
     RenderConfig config_;
+    std::unique_ptr<Simulation> skeleton_source_;  // skeleton and terrain of the run's configuration
     std::unique_ptr<render::View> view_;
-    const Terrain* terrain_ = nullptr;
+    std::atomic<bool>* stop_flag_ = nullptr;
     float ankle_height_ = 0.0f;
+    double tick_rate_ = 240.0;
     PuppetState drawn_;
     render::DebugOverlay overlay_;
-    std::chrono::steady_clock::time_point last_frame_{};
-    std::chrono::nanoseconds frame_interval_{16'666'667};
+    std::array<char, 256> hud_{};
+    std::int64_t last_frame_ns_ = 0;
     std::uint64_t frames_ = 0;
     int screenshots_ = 0;
 };

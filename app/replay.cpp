@@ -33,10 +33,11 @@ void write(const File& f, const std::string& text, const std::string& path) {
 
 std::string trace_csv_header() { return "tick,hash,root_x,root_y,root_z\n"; }
 
-std::string trace_csv_row(const PuppetState& s) {
+std::string trace_csv_row(const PuppetState& s) { return trace_csv_row(s.tick, hash_state(s), s.root_position); }
+
+std::string trace_csv_row(std::uint64_t tick, std::uint64_t state_hash, const vec3& root) {
     // fmt prints the shortest text that reads back to the same float.
-    return fmt::format("{},{:016x},{},{},{}\n", s.tick, hash_state(s), s.root_position.x, s.root_position.y,
-                       s.root_position.z);
+    return fmt::format("{},{:016x},{},{},{}\n", tick, state_hash, root.x, root.y, root.z);
 }
 
 ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name, const ReplayOptions& options) {

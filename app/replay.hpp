@@ -39,5 +39,7 @@ ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name,
 // byte-identical for the same ticks.
 std::string trace_csv_header();
 std::string trace_csv_row(const PuppetState& state);
+// The same row from its parts (the live pipeline hands these to its writer thread).
+std::string trace_csv_row(std::uint64_t tick, std::uint64_t state_hash, const vec3& root_position);
 
 }  // namespace marionette

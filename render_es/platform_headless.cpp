@@ -73,6 +73,8 @@ public:
         return glGetError() == kGlContextLost ? PresentResult::context_lost : PresentResult::ok;
     }
 
+    void release_current() override { eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT); }
+
     PlatformEvents poll_events() override { return {}; }
 
     bool recover() override {

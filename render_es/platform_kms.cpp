@@ -256,6 +256,8 @@ public:
         return PresentResult::ok;
     }
 
+    void release_current() override { eglMakeCurrent(egl_display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT); }
+
     PlatformEvents poll_events() override {
         PlatformEvents e;
         if (seat_.seat != nullptr) libseat_dispatch(seat_.seat, 0);  // VT switches

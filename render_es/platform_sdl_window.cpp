@@ -67,6 +67,8 @@ public:
         return glGetError() == kGlContextLost ? PresentResult::context_lost : PresentResult::ok;
     }
 
+    void release_current() override { SDL_GL_MakeCurrent(window_, nullptr); }
+
     PlatformEvents poll_events() override {
         PlatformEvents e;
         SDL_Event event;

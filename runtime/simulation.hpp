@@ -38,8 +38,10 @@ std::uint64_t hash_state(const PuppetState& state);
 class Simulation {
 public:
     // Builds the puppet and its clips and keeps a copy of the terrain it walks
-    // on (allocates); step() never does.
-    explicit Simulation(const SimConfig& config, const Terrain& terrain = {});
+    // on (allocates); step() never does. Without a terrain argument the
+    // configuration's own terrain (config.terrain) is used.
+    explicit Simulation(const SimConfig& config) : Simulation(config, config.terrain) {}
+    Simulation(const SimConfig& config, const Terrain& terrain);
 
     // Advances exactly one tick of 1/tick_rate_hz seconds.
     void step(const TickInput& input);
@@ -70,6 +72,10 @@ private:
     std::array<quat, kMaxJoints> walk_rotations_{};
     std::array<vec3, kMaxJoints> walk_translations_{};
 };
+
+// The first structural setting (one that cannot change while running: tick rate,
+// puppet proportions) that differs between two configurations, or "" when none.
+std::string structural_change(const SimConfig& running, const SimConfig& next);
 
 // Sets flush-to-zero / denormals-are-zero on the calling thread, the same way on
 // every thread that simulates (run and replay alike): denormals are slow and a
