@@ -38,6 +38,7 @@ constexpr double kMaxDifferingFraction = 0.01;
 struct Replayed {
     std::vector<PuppetState> states;
     Skeleton skeleton;
+    Terrain terrain;  // the configuration's (config/marionette.toml [terrain])
     float ankle_height = 0.0f;
 };
 Replayed replay_ticks(const std::string& program, std::vector<std::uint64_t> ticks) {
@@ -52,7 +53,10 @@ Replayed replay_ticks(const std::string& program, std::vector<std::uint64_t> tic
     Replayed out;
     ReplayOptions options;
     options.on_tick = [&](const Simulation& s) {
-        if (out.skeleton.joint_count() == 0) out.skeleton = s.skeleton();
+        if (out.skeleton.joint_count() == 0) {
+            out.skeleton = s.skeleton();
+            out.terrain = s.terrain();
+        }
         out.ankle_height = s.config().ankle_height;
         for (std::uint64_t t : ticks)
             if (s.state().tick == t) out.states.push_back(s.state());
@@ -111,13 +115,13 @@ Terrain test_steps() {
 }
 }  // namespace
 
-TEST_CASE("golden images: walk_stop mid-stride and circle with skeleton and foot overlays", "[render][golden]") {
+TEST_CASE("golden images: walk_stop mid-stride on the default terrain, circle with skeleton and foot overlays", "[render][golden]") {
     const RenderConfig rc = load_render_config("");
     render::RenderSettings settings = rc.settings;
     settings.show_hud = false;  // text is checked by the CLI frames, not pixel by pixel
     {
         const Replayed r = replay_ticks("walk_stop", {600});
-        render::View view(golden_platform(), settings, r.skeleton, Terrain{});
+        render::View view(golden_platform(), settings, r.skeleton, r.terrain);
         view.frame(r.states[0], render::DebugOverlay{}, "", 1.0f / 60.0f);
         check_golden("walk_stop_t600", snapshot(view));
     }
@@ -242,7 +246,7 @@ TEST_CASE("the SDL window platform draws the golden frame under Xvfb", "[.window
     settings.show_hud = false;
     render::PlatformOptions options = golden_platform();
     options.kind = render::PlatformKind::window;
-    render::View view(options, settings, r.skeleton, Terrain{});
+    render::View view(options, settings, r.skeleton, r.terrain);
     INFO(view.platform().description());
     REQUIRE(view.platform().width() == kGoldenWidth);
     REQUIRE(view.platform().height() == kGoldenHeight);
