@@ -1,5 +1,7 @@
 #include "app/pipeline.hpp"
 
+#include "app/live_view.hpp"
+
 #include <fmt/format.h>
 #include <poll.h>
 #include <pthread.h>
@@ -262,7 +264,7 @@ void simulation_thread(PipelineShared& sh, SimulationLoop& loop, std::uint64_t t
 }
 
 void render_thread(PipelineShared& sh, int frame_rate_hz, std::int64_t t0, bool virtual_time,
-                   FrameTimeHistogram& frame_time) {
+                   FrameTimeHistogram& frame_time, LiveView* display) {
     FrameLoop frames(sh);
     const std::int64_t period = 1'000'000'000 / frame_rate_hz;
     std::int64_t deadline = t0 + period;
@@ -275,6 +277,10 @@ void render_thread(PipelineShared& sh, int frame_rate_hz, std::int64_t t0, bool 
         const std::int64_t start = monotonic_ns();
         const std::int64_t at = virtual_time ? sh.states.front().current_time_ns : start;
         sink = sink + frames.run_frame(at).x;
+        if (display != nullptr && frames.has_state()) {
+            const StateFrame& f = sh.states.front();
+            display->frame(f.previous, f.current, static_cast<float>(frames.alpha()));
+        }
         const std::int64_t end = monotonic_ns();
         frame_time.add(end - start);
         if (end - start > window_max) window_max = end - start;
@@ -292,6 +298,7 @@ void render_thread(PipelineShared& sh, int frame_rate_hz, std::int64_t t0, bool 
             sh.counters.missed_frames.store(missed, std::memory_order_relaxed);
         }
     }
+    if (display != nullptr) display->release_thread();
 }
 
 const char* activity(float speed) {
@@ -437,7 +444,7 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
                                  !o.script.stamp_when_read, std::ref(sim_result));
         in_thread = std::thread(input_thread, std::ref(sh), std::cref(o.script), t0, o.virtual_time);
         gfx_thread = std::thread(render_thread, std::ref(sh), o.frame_rate_hz, t0, o.virtual_time,
-                                 std::ref(result.frame_time));
+                                 std::ref(result.frame_time), o.display);
     } catch (...) {
         pthread_sigmask(SIG_SETMASK, &previous_mask, nullptr);
         throw;

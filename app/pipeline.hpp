@@ -181,6 +181,8 @@ InputScript script_from_log(const DecodedInputLog& log, std::int64_t tick_ns);
 using TickTimeHistogram = DurationHistogram<1'000, 2048>;     // 1 µs buckets, ≤ 2 ms
 using FrameTimeHistogram = DurationHistogram<1'000, 4096>;    // 1 µs buckets, ≤ 4 ms
 
+class LiveView;  // app/live_view.hpp
+
 struct PipelineOptions {
     SimConfig config;
     InputScript script;
@@ -190,6 +192,9 @@ struct PipelineOptions {
     // waiting for every sample up to its time, so the run is deterministic.
     bool virtual_time = false;
     int frame_rate_hz = 60;            // the headless frame loop's pace
+    // Render (issue 7): a window or KMS display the render thread draws each frame
+    // on (opened by the caller, its context released); nullptr: headless frames.
+    LiveView* display = nullptr;
     std::string record_file;           // input log ("" = none)
     std::string trace_file;            // per-tick CSV ("" = none)
     std::string watch_config_file;     // live tuning ("" = none)

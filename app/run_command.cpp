@@ -13,6 +13,7 @@
 #include "app/config.hpp"
 #include "app/files.hpp"
 #include "app/json.hpp"
+#include "app/live_view.hpp"
 #include "app/pipeline.hpp"
 #include "app/program_source.hpp"
 #include "app/replay.hpp"
@@ -73,9 +74,6 @@ int run_command(const RunOptions& o) {
         throw ImportError("--input " + input, 0,
                           "not available in this build: the device backends have not landed yet "
                           "(use --input sim:PROGRAM or --input log:FILE)");
-    if (o.display == "kms" || o.display == "window")
-        throw ImportError("--display " + o.display, 0,
-                          "not available in this build: the GLES renderer has not landed yet (use --display headless)");
     if (!o.unplug.empty() && input.rfind("sim:", 0) != 0)
         throw ImportError("--sim-unplug", 0, "only the simulated controller (--input sim:PROGRAM) can be unplugged");
 
@@ -123,8 +121,13 @@ int run_command(const RunOptions& o) {
     p.watch_config_file = o.config_file;  // live tuning of the file given
     p.stop_request = &g_stop_requested;
     p.stop_request_time_ns = &g_stop_requested_ns;
+    // A window or KMS display when --display (or auto) picks one; nullptr: console only.
+    g_stop_requested.store(false);
+    const std::unique_ptr<LiveView> live = LiveView::open(o.display, o.render_config_file, config, &g_stop_requested);
+    p.display = live.get();
+    if (live) fmt::print("display: {}\n", live->description());
 
-    fmt::print("marionette: headless run, {} at {} Hz for {:.1f} s{}\n", source, config.tick_rate_hz,
+    fmt::print("marionette: {}, {} at {} Hz for {:.1f} s{}\n", live ? "run" : "headless run", source, config.tick_rate_hz,
                static_cast<double>(p.total_ticks) / config.tick_rate_hz, o.fast ? " (no real-time pacing)" : "");
     if (!o.config_file.empty()) fmt::print("marionette: watching {} for live tuning\n", o.config_file);
     std::fflush(stdout);
@@ -161,7 +164,9 @@ void register_run_command(CLI::App& app, int& exit_code) {
     cmd->add_option("--config", o->config_file, "TOML file overriding the defaults; watched for live tuning")
         ->check(CLI::ExistingFile);
     cmd->add_option("--input", o->input, "auto|evdev|hidapi|sdl|sim:PROGRAM|log:FILE (PROGRAM: a file or builtin:NAME)");
-    cmd->add_option("--display", o->display, "auto|kms|window|headless")
+    cmd->add_option("--render-config", o->render_config_file, "render settings TOML overriding config/render.toml")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--display", o->display, "auto|kms|window|headless (auto: a window under X11/Wayland, KMS on a console, else none)")
         ->check(CLI::IsMember({"auto", "headless", "kms", "window"}));
     cmd->add_option("--record", o->record_file, "write the input log here");
     cmd->add_option("--trace", o->trace_file, "per-tick CSV: tick,hash,root_x,root_y,root_z (as replay --trace)");
