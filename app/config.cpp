@@ -60,6 +60,16 @@ const KeySpec kKeys[] = {
     {"realtime", "simulation_cpu", &SimConfig::simulation_cpu, -1, 1023, "CPU the simulation thread is pinned to (-1: any)"},
     {"realtime", "render_cpu", &SimConfig::render_cpu, -1, 1023, "CPU the render thread is pinned to (-1: any)"},
     {"realtime", "lock_memory", &SimConfig::lock_memory, 0, 1, "1: lock all memory (mlockall) before the threads start"},
+    // motion graph (docs/motion-graph.md)
+    {"motion_graph", "analysis_rate_hz", &SimConfig::graph_analysis_rate_hz, 5, 240, "rate clips are resampled to for the graph build"},
+    {"motion_graph", "window_frames", &SimConfig::graph_window_frames, 2, 120, "k: frames in the distance window and in each transition"},
+    {"motion_graph", "neighbourhood_frames", &SimConfig::graph_neighbourhood_frames, 1, 60, "local minima are taken over (2h+1)² frame pairs"},
+    {"motion_graph", "threshold_percentile", &SimConfig::graph_threshold_percentile, 0.01, 100.0, "transition threshold as a percentile of all pair distances"},
+    {"motion_graph", "threshold_absolute", &SimConfig::graph_threshold_absolute, 0.0, 100.0, "when > 0, the threshold itself (mean squared distance in leg lengths²)"},
+    {"motion_graph", "bridge_percentile", &SimConfig::graph_bridge_percentile, 0.01, 100.0, "clips cut off from the component get their cheapest transitions below this percentile"},
+    {"motion_graph", "contact_height", &SimConfig::graph_contact_height, 0.0, 1.0, "foot contact: height above the clip's ground, leg lengths"},
+    {"motion_graph", "contact_speed", &SimConfig::graph_contact_speed, 0.0, 10.0, "foot contact: ground-plane speed, leg lengths per second"},
+    {"motion_graph", "transition_weight", &SimConfig::graph_transition_weight, 0.0, 1000.0, "path cost: seconds charged per unit of transition distance"},
 };
 
 int line_of(const toml::node& node) { return static_cast<int>(node.source().begin.line); }
