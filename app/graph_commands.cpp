@@ -4,10 +4,6 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
-#define STB_IMAGE_WRITE_IMPLEMENTATION
-#define STBI_WRITE_NO_STDIO_UNUSED
-#include <stb/stb_image_write.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -18,6 +14,7 @@
 #include "app/config.hpp"
 #include "app/embedded.hpp"
 #include "app/files.hpp"
+#include "render_es/image.hpp"
 #include "app/graph_files.hpp"
 #include "app/json.hpp"
 #include "motion_graph/graph_builder.hpp"
@@ -109,8 +106,18 @@ void write_plot(const std::string& path, const graph::GraphBuildOutput& out) {
                 p[2] = 0;
             }
     }
-    if (!stbi_write_png(path.c_str(), size, size, 3, rgb.data(), size * 3))
-        throw std::runtime_error(path + ": cannot write the PNG");
+    // One PNG writer in the project (render_es/image.hpp, stb_image_write).
+    render::Image image;
+    image.width = size;
+    image.height = size;
+    image.rgba.resize(static_cast<size_t>(size) * static_cast<size_t>(size) * 4);
+    for (size_t i = 0, n_px = static_cast<size_t>(size) * static_cast<size_t>(size); i < n_px; ++i) {
+        image.rgba[i * 4 + 0] = rgb[i * 3 + 0];
+        image.rgba[i * 4 + 1] = rgb[i * 3 + 1];
+        image.rgba[i * 4 + 2] = rgb[i * 3 + 2];
+        image.rgba[i * 4 + 3] = 255;
+    }
+    render::write_png(path, image);
 }
 
 std::string dot_text(const MotionGraph& g) {
