@@ -69,6 +69,24 @@ const KeySpec kKeys[] = {
     {"gait", "stop_transition_s", &SimConfig::stop_transition_s, 0.05, 1.0, "longest time the swing foot takes to plant after a stop (s)"},
     {"gait", "breath_amplitude", &SimConfig::breath_amplitude, 0.0, 0.05, "pelvis rise of a breath when idle (m)"},
     {"gait", "breath_period_s", &SimConfig::breath_period_s, 0.5, 20.0, "length of one breath (s)"},
+    // [realtime]: `marionette run` thread settings, applied at start only.
+    {"realtime", "input_priority", &SimConfig::input_priority, 0, 99, "SCHED_FIFO priority of the input thread (0: normal scheduling)"},
+    {"realtime", "simulation_priority", &SimConfig::simulation_priority, 0, 99, "SCHED_FIFO priority of the simulation thread (0: normal scheduling)"},
+    {"realtime", "render_priority", &SimConfig::render_priority, 0, 99, "SCHED_FIFO priority of the render thread (0: normal scheduling)"},
+    {"realtime", "input_cpu", &SimConfig::input_cpu, -1, 1023, "CPU the input thread is pinned to (-1: any)"},
+    {"realtime", "simulation_cpu", &SimConfig::simulation_cpu, -1, 1023, "CPU the simulation thread is pinned to (-1: any)"},
+    {"realtime", "render_cpu", &SimConfig::render_cpu, -1, 1023, "CPU the render thread is pinned to (-1: any)"},
+    {"realtime", "lock_memory", &SimConfig::lock_memory, 0, 1, "1: lock all memory (mlockall) before the threads start"},
+    // motion graph (docs/motion-graph.md)
+    {"motion_graph", "analysis_rate_hz", &SimConfig::graph_analysis_rate_hz, 5, 240, "rate clips are resampled to for the graph build"},
+    {"motion_graph", "window_frames", &SimConfig::graph_window_frames, 2, 120, "k: frames in the distance window and in each transition"},
+    {"motion_graph", "neighbourhood_frames", &SimConfig::graph_neighbourhood_frames, 1, 60, "local minima are taken over (2h+1)² frame pairs"},
+    {"motion_graph", "threshold_percentile", &SimConfig::graph_threshold_percentile, 0.01, 100.0, "transition threshold as a percentile of all pair distances"},
+    {"motion_graph", "threshold_absolute", &SimConfig::graph_threshold_absolute, 0.0, 100.0, "when > 0, the threshold itself (mean squared distance in leg lengths²)"},
+    {"motion_graph", "bridge_percentile", &SimConfig::graph_bridge_percentile, 0.01, 100.0, "clips cut off from the component get their cheapest transitions below this percentile"},
+    {"motion_graph", "contact_height", &SimConfig::graph_contact_height, 0.0, 1.0, "foot contact: height above the clip's ground, leg lengths"},
+    {"motion_graph", "contact_speed", &SimConfig::graph_contact_speed, 0.0, 10.0, "foot contact: ground-plane speed, leg lengths per second"},
+    {"motion_graph", "transition_weight", &SimConfig::graph_transition_weight, 0.0, 1000.0, "path cost: seconds charged per unit of transition distance"},
 };
 
 int line_of(const toml::node& node) { return static_cast<int>(node.source().begin.line); }

@@ -78,8 +78,7 @@ Simulation::Simulation(const SimConfig& config, const Terrain& terrain) : config
     pose_from_gait();
 }
 
-std::string Simulation::retune(const SimConfig& next) {
-    const SimConfig& c = config_;
+std::string structural_change(const SimConfig& c, const SimConfig& next) {
     if (next.tick_rate_hz != c.tick_rate_hz) return "simulation.tick_rate_hz";
     const float SimConfig::*const structural[] = {
         &SimConfig::pelvis_height, &SimConfig::hip_width, &SimConfig::thigh_length, &SimConfig::shin_length,
@@ -89,9 +88,16 @@ std::string Simulation::retune(const SimConfig& next) {
     for (auto field : structural)
         if (next.*field != c.*field) return "puppet (skeleton proportions)";
     if (!(next.terrain == c.terrain)) return "terrain";
-    config_ = next;
-    rig_ = make_gait_rig(config_);
     return {};
+}
+
+std::string Simulation::retune(const SimConfig& next) {
+    std::string key = structural_change(config_, next);
+    if (key.empty()) {
+        config_ = next;
+        rig_ = make_gait_rig(config_);
+    }
+    return key;
 }
 
 void Simulation::pose_from_gait() {

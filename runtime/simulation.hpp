@@ -73,6 +73,10 @@ private:
     PuppetState state_;
 };
 
+// The first structural setting (one that cannot change while running: tick rate,
+// puppet proportions) that differs between two configurations, or "" when none.
+std::string structural_change(const SimConfig& running, const SimConfig& next);
+
 // Sets flush-to-zero / denormals-are-zero on the calling thread, the same way on
 // every thread that simulates (run and replay alike): denormals are slow and a
 // flag set on one path only would break replay.
