@@ -3,6 +3,9 @@
 // documentation of each key live with the TOML schema (app/config.cpp,
 // docs/config.md); the defaults here are the ones config/marionette.toml states.
 #include <cstdint>
+#include <string>
+
+#include "runtime/terrain.hpp"
 
 namespace marionette {
 
@@ -35,6 +38,32 @@ struct SimConfig {
     float turn_rate_deg_s = 360.0f;        // heading follows the movement direction
     float stick_deadzone = 0.12f;          // radial, fraction of full deflection
     float response_curve = 0.5f;           // 0 linear … 1 quadratic: f(d) = (1−c)·d + c·d²
+
+    // [terrain] the ground walked on: `name` is where it came from (a built-in
+    // name or a file path, resolved by app/); the data travel inline in every
+    // effective configuration, so a log fully determines its ground. Built-in
+    // default: flat (the shipped config/marionette.toml names stairs).
+    std::string terrain_name = "flat";
+    Terrain terrain;
+    // [realtime] `marionette run` thread settings (app/realtime.cpp); never read by
+    // the tick. Priority 0 = normal scheduling, 1–99 = SCHED_FIFO; cpu −1 = any.
+    std::int32_t input_priority = 0;
+    std::int32_t simulation_priority = 0;
+    std::int32_t render_priority = 0;
+    std::int32_t input_cpu = -1;
+    std::int32_t simulation_cpu = -1;
+    std::int32_t render_cpu = -1;
+    std::int32_t lock_memory = 0;          // 1: mlockall(MCL_CURRENT | MCL_FUTURE) before the threads start
+    // [motion_graph] build parameters and path costs (docs/motion-graph.md)
+    std::int32_t graph_analysis_rate_hz = 30;     // clips are resampled to this rate for the build
+    std::int32_t graph_window_frames = 10;        // k: distance window and transition length
+    std::int32_t graph_neighbourhood_frames = 4;  // local minima over (2h+1)² pairs
+    float graph_threshold_percentile = 5.0f;      // threshold as a percentile of all distances
+    float graph_threshold_absolute = 0.0f;        // > 0: absolute threshold (leg lengths²) instead
+    float graph_bridge_percentile = 90.0f;        // looser percentile for bridges into cut-off clips
+    float graph_contact_height = 0.08f;           // foot contact: height above ground, leg lengths
+    float graph_contact_speed = 0.6f;             // foot contact: speed, leg lengths per second
+    float graph_transition_weight = 1.0f;         // path cost: seconds per unit of transition distance
 };
 
 }  // namespace marionette
