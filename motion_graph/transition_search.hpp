@@ -27,12 +27,15 @@ struct FrameFeatures {
     std::int32_t joints = 0;
     std::int32_t window = 10;            // k
     double weight = 0.0;                 // Σ w_j
-    std::vector<float> xz;               // [f][2J]: √w(x − cx)…, √w(z − cz)…
+    std::vector<float> xz;               // [f][2J]: √w(x − cx)…, √w(z − cz)… (c: frame centroid)
     std::vector<float> zx;               // [f][2J]: √w(z − cz)…, −√w(x − cx)…
     std::vector<float> y;                // [f][J]:  √w·y
     std::vector<double> cx, cz;          // weighted ground-plane centroid per frame
     std::vector<double> window_spread;   // per window start: Σ w|p − centroid|² over the window
     std::vector<double> window_cx, window_cz;  // per window start: Σ_t c over the window
+    // Per window start, 2k floats: √W·(c_t − window mean) as x…, z… (and z…, −x…),
+    // whose products give the centroid part of the alignment sums.
+    std::vector<float> window_dot, window_cross;
     std::vector<std::int32_t> clip_of;   // clip index of every frame
     std::vector<std::uint8_t> start_ok;  // the window starting here stays in one clip
     std::vector<std::uint8_t> end_ok;    // the window ending here stays in one clip
