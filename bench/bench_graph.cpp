@@ -8,6 +8,7 @@
 #include <sys/resource.h>
 
 #include <chrono>
+#include <ctime>
 #include <cstdlib>
 #include <random>
 
@@ -22,6 +23,14 @@ namespace {
 std::string mocap_dir() {
     const char* env = std::getenv("MARIONETTE_MOCAP_DIR");
     return env && *env ? env : MARIONETTE_DEFAULT_MOCAP_DIR;
+}
+
+// CPU seconds of the whole process: with other work on the machine, wall time
+// over-states single-threaded costs; the speed-up ratio uses CPU time.
+double process_cpu_s() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
 double peak_rss_mb() {
@@ -111,10 +120,12 @@ void BM_BuildSynthetic(benchmark::State& state) {
     const ClipDatabase db = synthetic(frames);
     for (auto _ : state) {
         const auto t0 = std::chrono::steady_clock::now();
+        const double c0 = process_cpu_s();
         GraphBuildParams params;
         params.bridge_percentile = params.threshold_percentile;  // no bridges: the copies connect by themselves
         const GraphBuildOutput out = build_motion_graph(db, params);
         report_build(state, out, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+        state.counters["cpu_s"] = process_cpu_s() - c0;
     }
 }
 
@@ -130,11 +141,17 @@ void BM_ReferenceSpeedup(benchmark::State& state) {
     o.threshold = distance_percentiles(f, {5.0})[0];
     o.threads = 1;
     for (auto _ : state) {
+        const double c0 = process_cpu_s();
         const auto t0 = std::chrono::steady_clock::now();
         const CandidateSearchResult tiled = find_transition_candidates(f, o);
         const auto t1 = std::chrono::steady_clock::now();
+        const double c1 = process_cpu_s();
         const CandidateSearchResult ref = find_transition_candidates_reference(db, p, f, leg, o);
         const auto t2 = std::chrono::steady_clock::now();
+        const double c2 = process_cpu_s();
+        state.counters["tiled_cpu_s"] = c1 - c0;
+        state.counters["reference_cpu_s"] = c2 - c1;
+        state.counters["speedup_cpu"] = (c2 - c1) / (c1 - c0);
         const double ts = std::chrono::duration<double>(t1 - t0).count(), rs = std::chrono::duration<double>(t2 - t1).count();
         size_t same = 0;
         for (size_t a = 0, b = 0; a < tiled.candidates.size() && b < ref.candidates.size();) {
