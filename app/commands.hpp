@@ -2,17 +2,20 @@
 // One function per `marionette` subcommand; main.cpp only parses the command line.
 // Each returns the process exit code: 0 success, 1 failure, 2 bad input.
 #include <string>
+#include <vector>
 
 namespace marionette {
 
 struct RunOptions {
     std::string config_file;
-    std::string input = "sim:builtin:demo";  // sim:PROGRAM (a file, or builtin:NAME)
+    std::string input = "auto";              // auto|evdev|hidapi|sdl|sim:PROGRAM|log:FILE
     std::string display = "auto";
     std::string record_file;
     std::string trace_file;
-    double duration_s = -1.0;                // < 0: until the program ends
-    bool fast = false;                       // no real-time pacing
+    std::string stats_json;
+    double duration_s = -1.0;                // < 0: until the input ends
+    std::vector<double> unplug;              // pairs: at, for (seconds), simulated controller only
+    bool fast = false;                       // no real-time pacing: virtual time
 };
 int run_command(const RunOptions& options);
 

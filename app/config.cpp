@@ -9,6 +9,7 @@
 #include <variant>
 
 #include "app/embedded.hpp"
+#include "app/terrain_file.hpp"
 
 namespace marionette {
 
@@ -51,6 +52,14 @@ const KeySpec kKeys[] = {
     {"locomotion", "turn_rate_deg_s", &SimConfig::turn_rate_deg_s, 1.0, 3600.0, "how fast the heading follows the direction of travel (°/s)"},
     {"locomotion", "stick_deadzone", &SimConfig::stick_deadzone, 0.0, 0.9, "radial deadzone, fraction of full deflection"},
     {"locomotion", "response_curve", &SimConfig::response_curve, 0.0, 1.0, "0 linear … 1 quadratic response of speed to deflection"},
+    // [realtime]: `marionette run` thread settings, applied at start only.
+    {"realtime", "input_priority", &SimConfig::input_priority, 0, 99, "SCHED_FIFO priority of the input thread (0: normal scheduling)"},
+    {"realtime", "simulation_priority", &SimConfig::simulation_priority, 0, 99, "SCHED_FIFO priority of the simulation thread (0: normal scheduling)"},
+    {"realtime", "render_priority", &SimConfig::render_priority, 0, 99, "SCHED_FIFO priority of the render thread (0: normal scheduling)"},
+    {"realtime", "input_cpu", &SimConfig::input_cpu, -1, 1023, "CPU the input thread is pinned to (-1: any)"},
+    {"realtime", "simulation_cpu", &SimConfig::simulation_cpu, -1, 1023, "CPU the simulation thread is pinned to (-1: any)"},
+    {"realtime", "render_cpu", &SimConfig::render_cpu, -1, 1023, "CPU the render thread is pinned to (-1: any)"},
+    {"realtime", "lock_memory", &SimConfig::lock_memory, 0, 1, "1: lock all memory (mlockall) before the threads start"},
     // motion graph (docs/motion-graph.md)
     {"motion_graph", "analysis_rate_hz", &SimConfig::graph_analysis_rate_hz, 5, 240, "rate clips are resampled to for the graph build"},
     {"motion_graph", "window_frames", &SimConfig::graph_window_frames, 2, 120, "k: frames in the distance window and in each transition"},
@@ -80,7 +89,7 @@ std::string known_tables() {
             out += (out.empty() ? "" : ", ") + std::string(k.table);
             last = k.table;
         }
-    return out;
+    return out + ", terrain";
 }
 
 template <typename Number>
@@ -91,6 +100,40 @@ std::string format_number(Number v) {
     std::string s(buf, end);
     if (s.find_first_of(".eE") == std::string::npos && s.find("inf") == std::string::npos) s += ".0";
     return s;
+}
+
+// [terrain]: `name` (a built-in terrain or a file path) and/or inline data
+// (heightfield, box, slope), which win when present: logs carry them inline.
+void apply_terrain_table(SimConfig& config, const toml::table& table, const std::string& file) {
+    std::string name = config.terrain_name;
+    const Terrain inline_data = terrain_from_table(table, file, "terrain.");  // also rejects unknown keys
+    if (const toml::node* n = table.get("name")) {
+        const auto* s = n->as_string();
+        if (!s) throw ConfigError(file, line_of(*n), "terrain.name", "expected a string: flat, stairs, slope, rubble or a file path");
+        name = s->get();
+        if (!table_has_terrain_data(table)) {
+            bool builtin = false;
+            for (const char* b : kBuiltinTerrains) builtin = builtin || name == b || name == "builtin:" + std::string(b);
+            if (!builtin && !std::ifstream(name))
+                throw ConfigError(file, line_of(*n), "terrain.name",
+                                  "no terrain '" + name + "' (expected flat, stairs, slope, rubble or a readable file path)");
+            config.terrain = load_terrain(name);
+        }
+    }
+    if (table_has_terrain_data(table)) {
+        config.terrain = inline_data;
+        if (!table.contains("name")) name = "inline";
+    }
+    config.terrain_name = name;
+}
+
+std::string toml_string(const std::string& s) {
+    std::string out = "\"";
+    for (char ch : s) {
+        if (ch == '"' || ch == '\\') out += '\\';
+        out += ch;
+    }
+    return out + "\"";
 }
 
 std::string read_file(const std::string& path) {
@@ -122,11 +165,15 @@ SimConfig apply_config_text(const SimConfig& base, std::string_view text, const 
     for (const auto& [table_key, table_node] : doc) {
         const std::string table_name(table_key.str());
         const std::string known = known_keys_of(table_name);
-        if (known.empty())
+        if (known.empty() && table_name != "terrain")
             throw ConfigError(file, line_of(table_node), table_name,
                               "unknown table (expected one of: " + known_tables() + ")");
         const toml::table* table = table_node.as_table();
         if (!table) throw ConfigError(file, line_of(table_node), table_name, "expected a table ([" + table_name + "])");
+        if (table_name == "terrain") {
+            apply_terrain_table(config, *table, file);
+            continue;
+        }
         for (const auto& [key, node] : *table) {
             const std::string full = table_name + "." + std::string(key.str());
             const KeySpec* spec = nullptr;
@@ -189,6 +236,9 @@ std::string serialize_config(const SimConfig& config) {
             out += format_number(config.*std::get<FloatField>(k.field));
         out += "\n";
     }
+    // The terrain, resolved and inline: the text alone determines the ground.
+    out += "\n[terrain]\nname = " + toml_string(config.terrain_name) + "\n";
+    out += serialize_terrain(config.terrain, "terrain.");
     return out;
 }
 

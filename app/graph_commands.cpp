@@ -4,10 +4,6 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
-#define STB_IMAGE_WRITE_IMPLEMENTATION
-#define STBI_WRITE_NO_STDIO_UNUSED
-#include <stb/stb_image_write.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -21,6 +17,7 @@
 #include "app/graph_files.hpp"
 #include "app/json.hpp"
 #include "motion_graph/graph_builder.hpp"
+#include "render_es/image.hpp"
 #include "runtime/bvh.hpp"
 #include "runtime/graph_path.hpp"
 
@@ -75,7 +72,7 @@ std::string label_names(const MotionGraph& g, std::uint32_t mask) {
 void write_plot(const std::string& path, const graph::GraphBuildOutput& out) {
     const int size = out.plot_size;
     const std::int64_t n = out.frames;
-    std::vector<unsigned char> rgb(static_cast<size_t>(size) * static_cast<size_t>(size) * 3, 0);
+    std::vector<unsigned char> rgb(static_cast<size_t>(size) * static_cast<size_t>(size) * 3, 0);  // RGB, then RGBA
     // Brightness falls with distance (scaled by 8× the threshold): bright = similar.
     const double scale = std::max(out.threshold * 8.0, 1e-12);
     for (int x = 0; x < size; ++x)
@@ -109,8 +106,11 @@ void write_plot(const std::string& path, const graph::GraphBuildOutput& out) {
                 p[2] = 0;
             }
     }
-    if (!stbi_write_png(path.c_str(), size, size, 3, rgb.data(), size * 3))
-        throw std::runtime_error(path + ": cannot write the PNG");
+    render::Image image;  // the renderer's PNG writer (one stb_image_write in the program)
+    image.width = image.height = size;
+    image.rgba.reserve(rgb.size() / 3 * 4);
+    for (size_t p = 0; p < rgb.size(); p += 3) image.rgba.insert(image.rgba.end(), {rgb[p], rgb[p + 1], rgb[p + 2], 255});
+    render::write_png(path, image);
 }
 
 std::string dot_text(const MotionGraph& g) {

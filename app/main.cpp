@@ -14,6 +14,8 @@ int main(int argc, char** argv) {
     register_run_command(app, exit_code);
     register_log_commands(app, exit_code);
     register_clip_commands(app, exit_code);
+    register_render_command(app, exit_code);
+    register_input_commands(app, exit_code);
     register_graph_commands(app, exit_code);
 
     try {

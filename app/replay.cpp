@@ -33,10 +33,11 @@ void write(const File& f, const std::string& text, const std::string& path) {
 
 std::string trace_csv_header() { return "tick,hash,root_x,root_y,root_z\n"; }
 
-std::string trace_csv_row(const PuppetState& s) {
+std::string trace_csv_row(const PuppetState& s) { return trace_csv_row(s.tick, hash_state(s), s.root_position); }
+
+std::string trace_csv_row(std::uint64_t tick, std::uint64_t state_hash, const vec3& root) {
     // fmt prints the shortest text that reads back to the same float.
-    return fmt::format("{},{:016x},{},{},{}\n", s.tick, hash_state(s), s.root_position.x, s.root_position.y,
-                       s.root_position.z);
+    return fmt::format("{},{:016x},{},{},{}\n", tick, state_hash, root.x, root.y, root.z);
 }
 
 ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name, const ReplayOptions& options) {
@@ -77,7 +78,8 @@ ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name,
     if (options.keep_tick_hashes) result.tick_hashes.reserve(log.ticks.size());
     size_t next_change = 0;
     vec3 previous_root = sim.state().root_position;
-    for (size_t k = 0; k < log.ticks.size(); ++k) {
+    bool keep_going = !options.on_tick || options.on_tick(sim);
+    for (size_t k = 0; k < log.ticks.size() && keep_going; ++k) {
         while (next_change < log.config_changes.size() && log.config_changes[next_change].before_tick <= k) {
             const SimConfig next = apply_config_text(sim.config(), log.config_changes[next_change].config_text,
                                                      fmt::format("{} (config change before tick {})", log_name, k));
@@ -92,6 +94,7 @@ ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name,
         result.distance_m += std::sqrt(static_cast<double>(d.x) * d.x + static_cast<double>(d.z) * d.z);
         previous_root = s.root_position;
         if (options.keep_tick_hashes) result.tick_hashes.push_back(hash_state(s));
+        if (options.on_tick) keep_going = options.on_tick(sim);
         if (trace) write(trace, trace_csv_row(s), options.trace_csv);
         if (joints) {
             std::string row = fmt::format("{}", s.tick);
@@ -106,7 +109,7 @@ ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name,
                                           s.local_translations.begin() + static_cast<std::ptrdiff_t>(joint_count));
         }
     }
-    result.ticks = log.ticks.size();
+    result.ticks = sim.state().tick;  // fewer than the log holds when on_tick stopped early
     result.final_hash = hash_state(sim.state());
     result.duration_s = static_cast<double>(result.ticks) / config.tick_rate_hz;
     result.final_root_position = sim.state().root_position;

@@ -2,6 +2,7 @@
 // Replaying an input log: the recorded TickInputs go straight into the
 // simulation, with no threads and no clock. Used by `marionette replay` and tests.
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,9 @@ struct ReplayOptions {
     std::string joints_csv;     // per tick: every joint's world position
     std::string bvh;            // the performed motion as a BVH animation
     bool keep_tick_hashes = false;
+    // Called with the simulation at its starting state and after every tick
+    // (`marionette render` draws frames from it). Returning false stops the replay.
+    std::function<bool(const Simulation&)> on_tick;
 };
 
 struct ReplayResult {
@@ -35,5 +39,7 @@ ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name,
 // byte-identical for the same ticks.
 std::string trace_csv_header();
 std::string trace_csv_row(const PuppetState& state);
+// The same row from its parts (the live pipeline hands these to its writer thread).
+std::string trace_csv_row(std::uint64_t tick, std::uint64_t state_hash, const vec3& root_position);
 
 }  // namespace marionette

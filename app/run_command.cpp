@@ -1,134 +1,178 @@
-// `marionette run`: the live program. Until the pipeline and renderer issues land
-// it is a single thread: a simulated controller (stick program) feeds the
-// fixed-step simulation in real time, headless, with a status line each second.
+// `marionette run`: the live program. It chooses the input and display, prepares
+// the pipeline (app/pipeline.hpp: input, simulation, render and writer threads),
+// turns SIGINT/SIGTERM into a clean stop, and reports the run's statistics.
 #include <fmt/format.h>
 
 #include <atomic>
-#include <chrono>
 #include <csignal>
 #include <memory>
-#include <thread>
 
 #include "app/cli.hpp"
+#include "app/clock.hpp"
 #include "app/commands.hpp"
 #include "app/config.hpp"
 #include "app/files.hpp"
+#include "app/json.hpp"
+#include "app/pipeline.hpp"
 #include "app/program_source.hpp"
 #include "app/replay.hpp"
-#include "runtime/fixed_step.hpp"
 
 namespace marionette {
 
 namespace {
 std::atomic<bool> g_stop_requested{false};
-extern "C" void on_stop_signal(int) { g_stop_requested.store(true); }
+std::atomic<std::int64_t> g_stop_requested_ns{0};
+static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<std::int64_t>::is_always_lock_free,
+              "the signal handler may only touch lock-free atomics");
 
-const char* activity(float speed) {
-    if (speed < 0.05f) return "standing";
-    if (speed < 2.0f) return "walking";
-    return "running";
+extern "C" void on_stop_signal(int) {
+    // clock_gettime is async-signal-safe; the time measures how fast we shut down.
+    if (!g_stop_requested.load()) g_stop_requested_ns.store(monotonic_ns());
+    g_stop_requested.store(true);
 }
 
-std::string status_line(const PuppetState& s, double seconds, double distance) {
-    const float speed = std::sqrt(s.velocity.x * s.velocity.x + s.velocity.y * s.velocity.y);
-    return fmt::format("[{:6.1f} s] {:<8} {:4.2f} m/s  heading {:4.0f}°  at ({:6.2f}, {:6.2f})  walked {:5.1f} m",
-                       seconds, activity(speed), speed, s.heading * det::kRadToDeg, s.root_position.x,
-                       s.root_position.z, distance);
+std::string histogram_json(std::int64_t p50, std::int64_t p99, std::int64_t max, std::int64_t mean) {
+    return fmt::format("{{\"p50\":{},\"p99\":{},\"max\":{},\"mean\":{}}}", json::number(p50 / 1e3),
+                       json::number(p99 / 1e3), json::number(max / 1e3), json::number(mean / 1e3));
 }
+template <typename Histogram>
+std::string histogram_json(const Histogram& h) {
+    return histogram_json(h.quantile_ns(0.5), h.quantile_ns(0.99), h.max_ns, h.mean_ns());
+}
+
+void write_stats_json(const std::string& path, const RunOptions& o, const SimConfig& config, const PipelineResult& r) {
+    const std::string text = fmt::format(
+        "{{\"input\":{},\"display\":\"headless\",\"tick_rate_hz\":{},\"ticks\":{},\"duration_s\":{},\"wall_s\":{},"
+        "\"stopped\":{},\"shutdown_ms\":{},\"final_hash\":\"{:016x}\","
+        "\"tick_time_us\":{},\"frame_time_us\":{},\"input_to_tick_latency_us\":{},"
+        "\"samples\":{},\"dropped_samples\":{},\"frames\":{},\"missed_frames\":{},\"catch_up_drops\":{},"
+        "\"records_dropped\":{},\"config_changes\":{},\"disconnects\":{},\"reconnects\":{},"
+        "\"distance_m\":{},\"top_speed_m_s\":{},\"realtime_warning\":{}}}\n",
+        json::quote(o.input), config.tick_rate_hz, r.ticks, json::number(static_cast<double>(r.ticks) / config.tick_rate_hz),
+        json::number(r.wall_s), r.stopped ? "true" : "false", json::number(r.shutdown_ms), r.final_hash,
+        histogram_json(r.tick_time), histogram_json(r.frame_time), histogram_json(r.input_latency), r.samples_pushed,
+        r.samples_dropped, r.frames, r.missed_frames, r.catch_up_drops, r.records_dropped, r.config_changes,
+        r.disconnects, r.reconnects, json::number(r.distance_m), json::number(r.top_speed),
+        r.realtime_warning.empty() ? "null" : json::quote(r.realtime_warning));
+    write_text_file(path, text);
+}
+
 }  // namespace
 
 int run_command(const RunOptions& o) {
-    const SimConfig config = load_config(o.config_file);
-    if (o.input.rfind("sim:", 0) != 0)
-        throw ImportError(o.input, 0, "only the simulated controller (--input sim:PROGRAM) is available in this build");
-    if (o.display != "auto" && o.display != "headless")
-        throw ImportError(o.display, 0, "only --display headless (or auto) is available in this build");
-    const StickProgram program = load_program(o.input.substr(4));
-    std::vector<TickInput> ticks = render_stick_program(program, config.tick_rate_hz);
-    std::uint64_t total_ticks = ticks.size();
-    if (o.duration_s >= 0.0) total_ticks = static_cast<std::uint64_t>(o.duration_s * config.tick_rate_hz + 0.5);
+    SimConfig config = load_config(o.config_file);
+    PipelineOptions p;
+    std::string source;
+    std::string input = o.input;
+    if (input == "auto") {
+        // No device backend is built in yet (input/ lands with its own issue), so
+        // auto means "no controller found": the simulated controller plays the demo.
+        input = "sim:builtin:demo";
+    }
+    if (input == "evdev" || input == "hidapi" || input == "sdl")
+        throw ImportError("--input " + input, 0,
+                          "not available in this build: the device backends have not landed yet "
+                          "(use --input sim:PROGRAM or --input log:FILE)");
+    if (o.display == "kms" || o.display == "window")
+        throw ImportError("--display " + o.display, 0,
+                          "not available in this build: the GLES renderer has not landed yet (use --display headless)");
+    if (!o.unplug.empty() && input.rfind("sim:", 0) != 0)
+        throw ImportError("--sim-unplug", 0, "only the simulated controller (--input sim:PROGRAM) can be unplugged");
 
-    fmt::print("marionette: headless run, simulated controller playing '{}' ({:.1f} s) at {} Hz\n", program.name,
-               static_cast<double>(total_ticks) / config.tick_rate_hz, config.tick_rate_hz);
+    if (input.rfind("sim:", 0) == 0) {
+        const StickProgram program = load_program(input.substr(4));
+        std::vector<UnplugWindow> unplug;
+        for (size_t i = 0; i + 1 < o.unplug.size(); i += 2) unplug.push_back({o.unplug[i], o.unplug[i + 1]});
+        p.script = script_from_program(program, kSimulatedControllerHz, unplug);
+        p.total_ticks = static_cast<std::uint64_t>(std::llround(program.duration_s() * config.tick_rate_hz));
+        source = fmt::format("simulated controller playing '{}' ({:.1f} s) at {} Hz", program.name,
+                             program.duration_s(), kSimulatedControllerHz);
+    } else if (input.rfind("log:", 0) == 0) {
+        const std::string file = input.substr(4);
+        const DecodedInputLog log = decode_input_log(read_binary_file(file), file);
+        if (!log.warning.empty()) fmt::print(stderr, "warning: {}\n", log.warning);
+        // The recording's own configuration, so the live replay matches it; --config may retune on top.
+        config = config_from_text(log.header.config_text, file + " (embedded configuration)");
+        if (!o.config_file.empty()) {
+            const SimConfig tuned = apply_config_text(config, read_text_file(o.config_file), o.config_file);
+            if (const std::string key = structural_change(config, tuned); !key.empty())
+                throw ConfigError(o.config_file, 0, key, "differs from the log's and cannot change for a live replay");
+            config = tuned;
+        }
+        SimConfig running = config;
+        for (const InputLogConfigChange& change : log.config_changes) {
+            const SimConfig next =
+                apply_config_text(running, change.config_text, fmt::format("{} (config change before tick {})", file, change.before_tick));
+            if (const std::string key = structural_change(running, next); !key.empty())
+                throw ImportError(file, 0, "recorded configuration change alters " + key + ", which cannot change live");
+            p.scheduled_changes.push_back({change.before_tick, next});
+            running = next;
+        }
+        p.script = script_from_log(log, 1'000'000'000 / config.tick_rate_hz);
+        p.total_ticks = log.ticks.size();
+        source = fmt::format("input log {} ({} ticks)", file, log.ticks.size());
+    } else {
+        throw ImportError("--input " + input, 0, "expected auto, evdev, hidapi, sdl, sim:PROGRAM or log:FILE");
+    }
+    if (o.duration_s >= 0.0) p.total_ticks = static_cast<std::uint64_t>(o.duration_s * config.tick_rate_hz + 0.5);
+
+    p.config = config;
+    p.virtual_time = o.fast;
+    p.record_file = o.record_file;
+    p.trace_file = o.trace_file;
+    p.watch_config_file = o.config_file;  // live tuning of the file given
+    p.stop_request = &g_stop_requested;
+    p.stop_request_time_ns = &g_stop_requested_ns;
+
+    fmt::print("marionette: headless run, {} at {} Hz for {:.1f} s{}\n", source, config.tick_rate_hz,
+               static_cast<double>(p.total_ticks) / config.tick_rate_hz, o.fast ? " (no real-time pacing)" : "");
+    if (!o.config_file.empty()) fmt::print("marionette: watching {} for live tuning\n", o.config_file);
     std::fflush(stdout);
 
-    set_simulation_float_mode();
-    Simulation sim(config);
-    std::unique_ptr<InputLogFile> log;
-    if (!o.record_file.empty()) {
-        InputLogHeader header;
-        header.tick_rate_hz = static_cast<std::uint32_t>(config.tick_rate_hz);
-        header.clip_data_hash = sim.clip_data_hash();
-        header.config_text = serialize_config(config);
-        log = std::make_unique<InputLogFile>(o.record_file, header);
-    }
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> trace(nullptr, &std::fclose);
-    if (!o.trace_file.empty()) {
-        trace.reset(std::fopen(o.trace_file.c_str(), "wb"));
-        if (!trace) throw std::runtime_error(o.trace_file + ": cannot create trace file");
-        std::fputs(trace_csv_header().c_str(), trace.get());
-    }
-
     g_stop_requested.store(false);
+    g_stop_requested_ns.store(0);
     std::signal(SIGINT, on_stop_signal);
     std::signal(SIGTERM, on_stop_signal);
+    const PipelineResult r = run_pipeline(p);
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
 
-    using Clock = std::chrono::steady_clock;
-    FixedStepDriver driver = FixedStepDriver::at_rate(config.tick_rate_hz, config.max_catch_up_ticks);
-    const std::uint32_t flush_every = static_cast<std::uint32_t>(config.tick_rate_hz / 4);  // ≤ 250 ms lost on a crash
-    const std::uint64_t status_every = static_cast<std::uint64_t>(config.tick_rate_hz);
-    auto last = Clock::now();
-    std::uint64_t k = 0;
-    double distance = 0.0;
-    float top_speed = 0.0f;
-    while (k < total_ticks && !g_stop_requested.load()) {
-        std::int32_t due = 1;
-        if (!o.fast) {
-            const auto now = Clock::now();
-            due = driver.advance(std::chrono::duration_cast<std::chrono::nanoseconds>(now - last).count());
-            last = now;
-        }
-        for (std::int32_t i = 0; i < due && k < total_ticks; ++i, ++k) {
-            const TickInput input = k < ticks.size() ? ticks[k] : TickInput{};
-            const vec3 before = sim.state().root_position;
-            sim.step(input);
-            const PuppetState& s = sim.state();
-            const vec3 d = s.root_position - before;
-            distance += std::sqrt(static_cast<double>(d.x) * d.x + static_cast<double>(d.z) * d.z);
-            top_speed = std::max(top_speed, std::sqrt(s.velocity.x * s.velocity.x + s.velocity.y * s.velocity.y));
-            if (log) {
-                log->append_tick(input);
-                if (log->pending_ticks() >= flush_every) log->flush();
-            }
-            if (trace) std::fputs(trace_csv_row(s).c_str(), trace.get());
-            if (s.tick % status_every == 0) {
-                fmt::print("{}\n", status_line(s, static_cast<double>(s.tick) / config.tick_rate_hz, distance));
-                std::fflush(stdout);
-            }
-        }
-        if (!o.fast) {
-            const auto next = last + std::chrono::nanoseconds(driver.tick_ns - driver.accumulated_ns);
-            std::this_thread::sleep_until(next);
-        }
+    if (!o.stats_json.empty()) write_stats_json(o.stats_json, o, config, r);
+    fmt::print("{}: {:.1f} s, {} ticks; walked {:.1f} m, top speed {:.2f} m/s; {} catch-up drops; "
+               "input→tick latency p50 {:.2f} ms p99 {:.2f} ms max {:.2f} ms; {} samples dropped; {} frames ({} missed); "
+               "final state hash {:016x}\n",
+               r.stopped ? "stopped" : "demo finished", static_cast<double>(r.ticks) / config.tick_rate_hz, r.ticks,
+               r.distance_m, r.top_speed, r.catch_up_drops, r.input_latency.quantile_ns(0.5) / 1e6,
+               r.input_latency.quantile_ns(0.99) / 1e6, r.input_latency.max_ns / 1e6, r.samples_dropped, r.frames,
+               r.missed_frames, r.final_hash);
+    if (r.stopped) fmt::print("shutdown: threads joined and files closed {:.1f} ms after the signal\n", r.shutdown_ms);
+    if (r.records_dropped > 0) {
+        fmt::print(stderr, "error: the writer fell behind and {} tick records were lost: {}{}are incomplete\n",
+                   r.records_dropped, o.record_file.empty() ? "" : o.record_file + " ",
+                   o.trace_file.empty() ? "" : o.trace_file + " ");
+        return 1;
     }
-    if (log) log->close();
-    const PuppetState& s = sim.state();
-    fmt::print("{}: {:.1f} s, {} ticks; walked {:.1f} m, top speed {:.2f} m/s; {} catch-up drops; final state hash {:016x}\n",
-               g_stop_requested.load() ? "stopped" : "demo finished", static_cast<double>(s.tick) / config.tick_rate_hz,
-               s.tick, distance, top_speed, driver.catch_up_cap_hits, hash_state(s));
     return 0;
 }
 
 void register_run_command(CLI::App& app, int& exit_code) {
     auto o = std::make_shared<RunOptions>();
     CLI::App* cmd = app.add_subcommand("run", "Run the puppet live (headless demo with a simulated controller by default)");
-    cmd->add_option("--config", o->config_file, "TOML file overriding the defaults")->check(CLI::ExistingFile);
-    cmd->add_option("--input", o->input, "sim:PROGRAM (a stick program file, or builtin:NAME)");
-    cmd->add_option("--display", o->display, "auto|headless")->check(CLI::IsMember({"auto", "headless", "kms", "window"}));
+    cmd->add_option("--config", o->config_file, "TOML file overriding the defaults; watched for live tuning")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--input", o->input, "auto|evdev|hidapi|sdl|sim:PROGRAM|log:FILE (PROGRAM: a file or builtin:NAME)");
+    cmd->add_option("--display", o->display, "auto|kms|window|headless")
+        ->check(CLI::IsMember({"auto", "headless", "kms", "window"}));
     cmd->add_option("--record", o->record_file, "write the input log here");
-    cmd->add_option("--trace", o->trace_file, "per-tick CSV: tick,hash,root_x,root_y,root_z");
-    cmd->add_option("--duration", o->duration_s, "seconds to run (default: until the program ends)")->check(CLI::Range(0.0, 86400.0));
-    cmd->add_flag("--fast", o->fast, "do not pace ticks in real time");
+    cmd->add_option("--trace", o->trace_file, "per-tick CSV: tick,hash,root_x,root_y,root_z (as replay --trace)");
+    cmd->add_option("--stats-json", o->stats_json, "write the run's statistics here as JSON");
+    cmd->add_option("--duration", o->duration_s, "seconds to run (default: until the input ends)")
+        ->check(CLI::Range(0.0, 86400.0));
+    cmd->add_option("--sim-unplug", o->unplug, "AT FOR: unplug the simulated controller at AT s for FOR s (repeatable)")
+        ->expected(2)
+        ->take_all()
+        ->check(CLI::Range(0.0, 86400.0));
+    cmd->add_flag("--fast", o->fast, "no real-time pacing: virtual time, as fast as the CPU allows (deterministic)");
     on_parsed(cmd, exit_code, [o] { return run_command(*o); });
 }
 

@@ -3,6 +3,9 @@
 // documentation of each key live with the TOML schema (app/config.cpp,
 // docs/config.md); the defaults here are the ones config/marionette.toml states.
 #include <cstdint>
+#include <string>
+
+#include "runtime/terrain.hpp"
 
 namespace marionette {
 
@@ -36,6 +39,21 @@ struct SimConfig {
     float stick_deadzone = 0.12f;          // radial, fraction of full deflection
     float response_curve = 0.5f;           // 0 linear … 1 quadratic: f(d) = (1−c)·d + c·d²
 
+    // [terrain] the ground walked on: `name` is where it came from (a built-in
+    // name or a file path, resolved by app/); the data travel inline in every
+    // effective configuration, so a log fully determines its ground. Built-in
+    // default: flat (the shipped config/marionette.toml names stairs).
+    std::string terrain_name = "flat";
+    Terrain terrain;
+    // [realtime] `marionette run` thread settings (app/realtime.cpp); never read by
+    // the tick. Priority 0 = normal scheduling, 1–99 = SCHED_FIFO; cpu −1 = any.
+    std::int32_t input_priority = 0;
+    std::int32_t simulation_priority = 0;
+    std::int32_t render_priority = 0;
+    std::int32_t input_cpu = -1;
+    std::int32_t simulation_cpu = -1;
+    std::int32_t render_cpu = -1;
+    std::int32_t lock_memory = 0;          // 1: mlockall(MCL_CURRENT | MCL_FUTURE) before the threads start
     // [motion_graph] build parameters and path costs (docs/motion-graph.md)
     std::int32_t graph_analysis_rate_hz = 30;     // clips are resampled to this rate for the build
     std::int32_t graph_window_frames = 10;        // k: distance window and transition length

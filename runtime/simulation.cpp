@@ -39,7 +39,7 @@ void set_simulation_float_mode() {
 #endif
 }
 
-Simulation::Simulation(const SimConfig& config) : config_(config) {
+Simulation::Simulation(const SimConfig& config, const Terrain& terrain) : config_(config), terrain_(terrain) {
     if (config_.tick_rate_hz <= 0) throw std::invalid_argument("tick_rate_hz must be positive");
     const Skeleton skeleton = make_puppet_skeleton(config_);
     if (skeleton.joint_count() > kMaxJoints) throw std::invalid_argument("puppet has too many joints");
@@ -54,8 +54,7 @@ Simulation::Simulation(const SimConfig& config) : config_(config) {
     update_model_space();
 }
 
-std::string Simulation::retune(const SimConfig& next) {
-    const SimConfig& c = config_;
+std::string structural_change(const SimConfig& c, const SimConfig& next) {
     if (next.tick_rate_hz != c.tick_rate_hz) return "simulation.tick_rate_hz";
     const float SimConfig::*const structural[] = {
         &SimConfig::pelvis_height, &SimConfig::hip_width, &SimConfig::thigh_length, &SimConfig::shin_length,
@@ -64,8 +63,14 @@ std::string Simulation::retune(const SimConfig& next) {
         &SimConfig::upper_arm_length, &SimConfig::forearm_length, &SimConfig::hand_length};
     for (auto field : structural)
         if (next.*field != c.*field) return "puppet (skeleton proportions)";
-    config_ = next;
+    if (!(next.terrain == c.terrain)) return "terrain";
     return {};
+}
+
+std::string Simulation::retune(const SimConfig& next) {
+    std::string key = structural_change(config_, next);
+    if (key.empty()) config_ = next;
+    return key;
 }
 
 void Simulation::update_model_space() {

@@ -8,6 +8,7 @@
 
 #include "runtime/clip.hpp"
 #include "runtime/sim_config.hpp"
+#include "runtime/terrain.hpp"
 #include "runtime/tick_input.hpp"
 
 namespace marionette {
@@ -36,8 +37,11 @@ std::uint64_t hash_state(const PuppetState& state);
 
 class Simulation {
 public:
-    // Builds the puppet and its clips (allocates); step() never does.
-    explicit Simulation(const SimConfig& config);
+    // Builds the puppet and its clips and keeps a copy of the terrain it walks
+    // on (allocates); step() never does. Without a terrain argument the
+    // configuration's own terrain (config.terrain) is used.
+    explicit Simulation(const SimConfig& config) : Simulation(config, config.terrain) {}
+    Simulation(const SimConfig& config, const Terrain& terrain);
 
     // Advances exactly one tick of 1/tick_rate_hz seconds.
     void step(const TickInput& input);
@@ -49,6 +53,7 @@ public:
 
     const PuppetState& state() const { return state_; }
     const SimConfig& config() const { return config_; }
+    const Terrain& terrain() const { return terrain_; }
     const Skeleton& skeleton() const { return idle_clip_.skeleton; }
     double tick_seconds() const { return 1.0 / config_.tick_rate_hz; }
     // Hash of the clip data the puppet animates, recorded in input logs.
@@ -58,6 +63,7 @@ private:
     void update_model_space();
 
     SimConfig config_;
+    Terrain terrain_;
     Clip idle_clip_;
     Clip walk_clip_;
     std::uint64_t clip_data_hash_ = 0;
@@ -66,6 +72,10 @@ private:
     std::array<quat, kMaxJoints> walk_rotations_{};
     std::array<vec3, kMaxJoints> walk_translations_{};
 };
+
+// The first structural setting (one that cannot change while running: tick rate,
+// puppet proportions) that differs between two configurations, or "" when none.
+std::string structural_change(const SimConfig& running, const SimConfig& next);
 
 // Sets flush-to-zero / denormals-are-zero on the calling thread, the same way on
 // every thread that simulates (run and replay alike): denormals are slow and a

@@ -21,6 +21,7 @@ struct Heightfield {
     std::int32_t nx = 0;
     std::int32_t nz = 0;
     std::vector<float> heights;
+    friend bool operator==(const Heightfield&, const Heightfield&) = default;
 };
 
 // A solid box standing on the ground from below: inside its XZ footprint the
@@ -31,6 +32,7 @@ struct TerrainBox {
     float max_x = 0.0f;
     float max_z = 0.0f;
     float top = 0.0f;
+    friend bool operator==(const TerrainBox&, const TerrainBox&) = default;
 };
 
 // A planar patch: inside its footprint the surface is at least
@@ -43,12 +45,14 @@ struct TerrainSlope {
     float base = 0.0f;
     float grade_x = 0.0f;
     float grade_z = 0.0f;
+    friend bool operator==(const TerrainSlope&, const TerrainSlope&) = default;
 };
 
 struct Terrain {
     Heightfield heightfield;
     std::vector<TerrainBox> boxes;
     std::vector<TerrainSlope> slopes;
+    friend bool operator==(const Terrain&, const Terrain&) = default;
 };
 
 struct GroundSample {

@@ -1,0 +1,232 @@
+#pragma once
+// The live pipeline (../shared/DESIGN.md, docs/pipeline.md):
+//
+//   input thread ──TimedInput──▶ SPSC ring ──▶ simulation thread ──TickRecord──▶ SPSC ring ──▶ writer (main thread)
+//                                                   │                                       log, trace, status, config
+//                                                   └──StateFrame──▶ triple buffer ──▶ render thread
+//
+// plus a configuration handoff (triple buffer) from the writer's file watcher
+// to the simulation. Every queue is single-producer/single-consumer with a fixed
+// capacity. Each thread's steady-state work is a plain method (SimulationLoop,
+// FrameLoop, InputRingWriter) that the zero-allocation test drives directly.
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "runtime/input_log.hpp"
+#include "runtime/latency_histogram.hpp"
+#include "runtime/latest_value.hpp"
+#include "runtime/simulation.hpp"
+#include "runtime/spsc_ring.hpp"
+#include "runtime/stick_program.hpp"
+#include "runtime/tick_input_assembler.hpp"
+
+namespace marionette {
+
+inline constexpr std::size_t kInputRingCapacity = 4096;    // 4 s of samples at 1 kHz
+inline constexpr std::size_t kRecordRingCapacity = 16384;  // 68 s of ticks at 240 Hz
+inline constexpr int kSimulatedControllerHz = 1000;
+
+using InputRing = SpscRing<TimedInput, kInputRingCapacity>;
+
+// What the render thread interpolates between: the two latest ticks.
+struct StateFrame {
+    PuppetState previous;
+    PuppetState current;
+    std::int64_t current_time_ns = 0;  // when `current`'s tick was due
+    std::int64_t tick_ns = 0;
+};
+
+// Simulation → writer, per tick (and per configuration change, in order).
+struct TickRecord {
+    enum class Kind : std::uint8_t { tick, config_change };
+    Kind kind = Kind::tick;
+    bool connected = true;        // the controller, as this tick saw it
+    std::uint64_t tick = 0;       // ticks completed after this one
+    std::uint64_t hash = 0;
+    TickInput input{};
+    // Plain floats: ring items must be trivially copyable, which GLM vectors are not.
+    std::array<float, 3> root_position{};
+    std::array<float, 2> velocity{};
+    float heading = 0.0f;
+    // config_change: which configuration is now in force. The configuration itself
+    // (it owns the terrain's arrays) stays with the writer, who made or read it:
+    // a live edit by its version, a recorded change by its index.
+    enum class ConfigSource : std::uint8_t { live_edit, recorded };
+    ConfigSource config_source = ConfigSource::live_edit;
+    std::uint32_t config_id = 0;
+};
+using RecordRing = SpscRing<TickRecord, kRecordRingCapacity>;
+
+// A validated configuration for the simulation to apply at its next tick boundary.
+struct ConfigUpdate {
+    std::uint32_t version = 0;
+    SimConfig config{};
+};
+
+// A change recorded in an input log, applied before tick `before_tick` (0-based).
+struct ScheduledConfigChange {
+    std::uint64_t before_tick = 0;
+    SimConfig config{};
+};
+
+// Written by one thread each, read (relaxed) by the status line.
+struct PipelineCounters {
+    std::atomic<std::uint64_t> samples_pushed{0};
+    std::atomic<std::uint64_t> samples_dropped{0};
+    std::atomic<std::uint64_t> frames{0};
+    std::atomic<std::uint64_t> missed_frames{0};
+    std::atomic<std::uint64_t> catch_up_drops{0};
+    std::atomic<std::uint64_t> records_dropped{0};
+    // Maxima over the last second, published once a second by their thread.
+    std::atomic<std::int64_t> tick_time_max_ns{0};
+    std::atomic<std::int64_t> input_latency_max_ns{0};
+    std::atomic<std::int64_t> frame_time_max_ns{0};
+};
+
+// Everything the threads share. Allocated once, before the threads start.
+struct PipelineShared {
+    InputRing input_ring;
+    RecordRing records;
+    LatestValue<StateFrame> states;
+    LatestValue<ConfigUpdate> config_updates;
+    // Virtual time only: the newest timestamp the input thread has pushed.
+    std::atomic<std::int64_t> input_watermark_ns{INT64_MIN};
+    std::atomic<bool> input_done{false};
+    std::atomic<bool> simulation_done{false};
+    std::atomic<bool> stop{false};
+    PipelineCounters counters;
+};
+
+// The simulation thread's work for one tick: apply a pending configuration,
+// drain the samples due, step, publish the state pair, hand a record to the
+// writer. No allocation, no lock, no system call.
+class SimulationLoop {
+public:
+    // `wait_when_full`: virtual time (nothing is real-time, so wait for the writer
+    // instead of dropping a record). `scheduled`: changes replayed from a log.
+    SimulationLoop(const SimConfig& config, PipelineShared& shared, std::vector<ScheduledConfigChange> scheduled = {},
+                   bool wait_when_full = false);
+    void run_tick(std::int64_t tick_time_ns, std::int64_t now_ns);
+
+    const Simulation& simulation() const { return sim_; }
+    const TickInputAssembler& assembler() const { return assembler_; }
+    const InputLatencyHistogram& input_latency() const { return latency_; }
+    std::uint64_t config_changes() const { return config_changes_; }
+
+private:
+    void apply(const SimConfig& config, TickRecord::ConfigSource source, std::uint32_t id);
+    void push(const TickRecord& record);
+
+    Simulation sim_;
+    PipelineShared& shared_;
+    std::vector<ScheduledConfigChange> scheduled_;
+    size_t next_scheduled_ = 0;
+    bool wait_when_full_ = false;
+    TickInputAssembler assembler_;
+    InputLatencyHistogram latency_;
+    std::int64_t latency_window_max_ns_ = 0;
+    std::uint64_t config_changes_ = 0;
+    TickRecord record_{};  // reused, so the tick builds no large temporaries
+};
+
+// The render thread's work for one frame: take the newest state pair and
+// interpolate it by alpha = (frame time − one tick − previous tick time) / dt,
+// i.e. one tick behind, so a frame never extrapolates. (The GLES renderer draws
+// from `joints()` once it lands.)
+class FrameLoop {
+public:
+    explicit FrameLoop(PipelineShared& shared) : shared_(shared) {}
+    // Returns the interpolated root position.
+    vec3 run_frame(std::int64_t frame_time_ns);
+    bool has_state() const { return has_state_; }
+    double alpha() const { return alpha_; }
+    const std::array<vec3, kMaxJoints>& joints() const { return joints_; }
+
+private:
+    PipelineShared& shared_;
+    bool has_state_ = false;
+    double alpha_ = 0.0;
+    std::array<vec3, kMaxJoints> joints_{};
+};
+
+// Where the input thread's samples come from, prepared before it starts:
+// events with timestamps relative to the start of the run.
+struct InputScript {
+    std::vector<TimedInput> events;  // non-decreasing timestamps
+    // True: a live controller, stamped with the clock when read (the script's
+    // time is when to read it). False: a recording, which keeps its stamps.
+    bool stamp_when_read = true;
+};
+
+// The controller is unplugged at `at_s` for `for_s` seconds (hot-plug tests).
+struct UnplugWindow {
+    double at_s = 0.0;
+    double for_s = 0.0;
+};
+
+// A stick program as a controller polled at `sample_rate_hz`, then left at rest
+// when the program ends; during an unplug window it sends nothing but the
+// disconnect marker.
+InputScript script_from_program(const StickProgram& program, int sample_rate_hz,
+                                const std::vector<UnplugWindow>& unplugged = {});
+// A recorded log played live: tick k's input is stamped just after tick k−1's
+// time, so tick k consumes exactly it.
+InputScript script_from_log(const DecodedInputLog& log, std::int64_t tick_ns);
+
+using TickTimeHistogram = DurationHistogram<1'000, 2048>;     // 1 µs buckets, ≤ 2 ms
+using FrameTimeHistogram = DurationHistogram<1'000, 4096>;    // 1 µs buckets, ≤ 4 ms
+
+struct PipelineOptions {
+    SimConfig config;
+    InputScript script;
+    std::vector<ScheduledConfigChange> scheduled_changes;
+    std::uint64_t total_ticks = 0;
+    // No clock: ticks run as fast as the input thread provides samples, each tick
+    // waiting for every sample up to its time, so the run is deterministic.
+    bool virtual_time = false;
+    int frame_rate_hz = 60;            // the headless frame loop's pace
+    std::string record_file;           // input log ("" = none)
+    std::string trace_file;            // per-tick CSV ("" = none)
+    std::string watch_config_file;     // live tuning ("" = none)
+    bool status_lines = true;          // once per simulated second
+    std::FILE* out = stdout;           // status lines and notices
+    std::FILE* err = stderr;           // configuration errors and warnings
+    // Set (by a signal handler) to ask for a clean stop; the time it was set, if known.
+    const std::atomic<bool>* stop_request = nullptr;
+    const std::atomic<std::int64_t>* stop_request_time_ns = nullptr;
+};
+
+struct PipelineResult {
+    std::uint64_t ticks = 0;
+    std::uint64_t final_hash = 0;
+    PuppetState final_state{};
+    double distance_m = 0.0;
+    float top_speed = 0.0f;
+    bool stopped = false;              // by stop_request, before the end
+    double shutdown_ms = 0.0;          // stop request → threads joined and files closed
+    double wall_s = 0.0;
+    InputLatencyHistogram input_latency;
+    TickTimeHistogram tick_time;
+    FrameTimeHistogram frame_time;
+    std::uint64_t samples_pushed = 0;
+    std::uint64_t samples_dropped = 0;
+    std::uint64_t frames = 0;
+    std::uint64_t missed_frames = 0;
+    std::uint64_t catch_up_drops = 0;
+    std::uint64_t records_dropped = 0;  // > 0: the log and trace are incomplete
+    std::uint64_t config_changes = 0;
+    std::uint64_t disconnects = 0;
+    std::uint64_t reconnects = 0;
+    std::string realtime_warning;       // what the [realtime] settings could not do
+};
+
+// Runs the whole pipeline until total_ticks have run or a stop is requested.
+// Throws std::runtime_error when an output cannot be created or written.
+PipelineResult run_pipeline(const PipelineOptions& options);
+
+}  // namespace marionette

@@ -1,0 +1,37 @@
+#include "app/realtime.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+#include <sys/mman.h>
+
+#include <cstring>
+
+namespace marionette {
+
+std::string apply_thread_settings(std::thread& thread, const char* name, int priority, int cpu) {
+    const pthread_t handle = thread.native_handle();
+    pthread_setname_np(handle, name);  // best effort: only for tools like top and gdb
+    std::string failed;
+    if (priority > 0) {
+        sched_param param{};
+        param.sched_priority = priority;
+        if (const int rc = pthread_setschedparam(handle, SCHED_FIFO, &param); rc != 0)
+            failed += std::string(name) + " thread SCHED_FIFO " + std::to_string(priority) + ": " + std::strerror(rc);
+    }
+    if (cpu >= 0) {
+        cpu_set_t set;
+        CPU_ZERO(&set);
+        CPU_SET(static_cast<unsigned>(cpu), &set);
+        if (const int rc = pthread_setaffinity_np(handle, sizeof set, &set); rc != 0)
+            failed += (failed.empty() ? "" : "; ") + std::string(name) + " thread on CPU " + std::to_string(cpu) +
+                      ": " + std::strerror(rc);
+    }
+    return failed;
+}
+
+std::string lock_all_memory() {
+    if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) return std::string("mlockall: ") + std::strerror(errno);
+    return {};
+}
+
+}  // namespace marionette

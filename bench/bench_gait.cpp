@@ -1,0 +1,60 @@
+// The gait's costs: two-bone IK per solve, and the whole tick per puppet idle,
+// walking and running (on flat ground and on rubble), with how many puppets one
+// core ticks at 240 Hz. Flush-to-zero is set as in run and replay.
+// Run: build/release/bench/marionette_bench_gait
+#include <benchmark/benchmark.h>
+
+#include "runtime/simulation.hpp"
+#include "runtime/two_bone_ik.hpp"
+
+using namespace marionette;
+
+namespace {
+
+void BM_TwoBoneIk(benchmark::State& state) {
+    set_simulation_float_mode();
+    TwoBoneIkInput in;
+    in.root = vec3(0.09f, 0.84f, 0.0f);
+    in.upper_length = 0.44f;
+    in.lower_length = 0.43f;
+    float x = 0.0f;
+    for (auto _ : state) {
+        x = x > 0.3f ? -0.3f : x + 0.001f;  // a moving target, so nothing is hoisted
+        in.target = vec3(0.09f + 0.1f * x, 0.08f, x);
+        benchmark::DoNotOptimize(solve_two_bone_ik(in));
+    }
+    state.counters["ns_per_solve"] =
+        benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_TwoBoneIk);
+
+void BM_GaitTick(benchmark::State& state) {
+    set_simulation_float_mode();
+    Terrain terrain;
+    if (state.range(1)) {  // rubble-like: 180 boxes around the path
+        for (int i = 0; i < 180; ++i) {
+            const float x = static_cast<float>((i * 37) % 120) / 10.0f - 6.0f;
+            const float z = static_cast<float>((i * 53) % 180) / 10.0f - 14.0f;
+            terrain.boxes.push_back({x, z, x + 0.3f, z + 0.4f, 0.01f * static_cast<float>(i % 8)});
+        }
+    }
+    Simulation sim(SimConfig{}, terrain);
+    TickInput in;
+    in.left_y = static_cast<std::int16_t>(state.range(0));
+    std::uint64_t k = 0;
+    for (auto _ : state) {
+        // Walk back and forth within the terrain: reverse every 4 s.
+        if (state.range(0) != 0 && (++k % 960) == 0) in.left_y = static_cast<std::int16_t>(-in.left_y);
+        sim.step(in);
+        benchmark::DoNotOptimize(sim.state().model_positions[0]);
+    }
+    const char* gait = state.range(0) == 0 ? "idle" : (state.range(0) < 30000 ? "walk" : "run");
+    state.SetLabel(std::string(gait) + (state.range(1) ? " on rubble" : " on flat"));
+    state.counters["puppets_at_240Hz_per_core"] =
+        benchmark::Counter(static_cast<double>(state.iterations()) / 240.0, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_GaitTick)->Args({0, 0})->Args({20000, 0})->Args({32767, 0})->Args({20000, 1})->Args({32767, 1});
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,144 @@
+// Headless platform: a surfaceless EGL context (EGL_MESA_platform_surfaceless,
+// else the first EGL_EXT_platform_device device) drawing into an FBO. Used for
+// tests, screenshots, offline frames and video; works on llvmpipe and real GPUs.
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <GLES3/gl3.h>
+
+#include <cstring>
+
+#include "render_es/egl_util.hpp"
+#include "render_es/gl_util.hpp"
+#include "render_es/platform.hpp"
+
+namespace marionette::render {
+
+namespace {
+constexpr GLenum kGlContextLost = 0x0507;  // GL_CONTEXT_LOST (GLES 3.2 / KHR_robustness)
+
+EGLDisplay surfaceless_display(std::string& which) {
+    const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+    auto has = [client](const char* name) { return client != nullptr && std::strstr(client, name) != nullptr; };
+    auto get_platform_display =
+        reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+    if (get_platform_display == nullptr) throw PlatformError("headless platform: EGL lacks eglGetPlatformDisplayEXT");
+    if (has("EGL_MESA_platform_surfaceless")) {
+        which = "surfaceless";
+        return get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+    }
+    if (has("EGL_EXT_platform_device")) {
+        auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+        EGLDeviceEXT devices[8];
+        EGLint count = 0;
+        if (query_devices != nullptr && query_devices(8, devices, &count) && count > 0) {
+            which = "device";
+            return get_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[0], nullptr);
+        }
+    }
+    throw PlatformError(
+        "headless platform: EGL offers neither EGL_MESA_platform_surfaceless nor EGL_EXT_platform_device "
+        "(install libegl-mesa0 for Mesa's llvmpipe)");
+}
+
+class HeadlessPlatform final : public Platform {
+public:
+    explicit HeadlessPlatform(const PlatformOptions& options) : options_(options) {
+        if (options.width <= 0 || options.height <= 0 || options.width > 16384 || options.height > 16384)
+            throw PlatformError("headless platform: size " + std::to_string(options.width) + "x" +
+                                std::to_string(options.height) + " is out of range (1..16384)");
+        display_ = surfaceless_display(which_);
+        egl_ = initialise_egl_display(display_, "headless");
+        create_context();
+    }
+
+    ~HeadlessPlatform() override {
+        release_context();
+        if (display_ != EGL_NO_DISPLAY) eglTerminate(display_);
+    }
+
+    PlatformKind kind() const override { return PlatformKind::headless; }
+    std::int32_t width() const override { return options_.width; }
+    std::int32_t height() const override { return options_.height; }
+
+    void begin_frame() override {
+        if (eglGetCurrentContext() != context_) eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_);
+        glBindFramebuffer(GL_FRAMEBUFFER, draw_.framebuffer);
+        glViewport(0, 0, options_.width, options_.height);
+    }
+
+    PresentResult present() override {
+        draw_.resolve_to(resolved_.framebuffer, resolved_.width, resolved_.height);
+        const GLenum error = glGetError();
+        if (error == kGlContextLost) return PresentResult::context_lost;
+        return error == GL_NO_ERROR ? PresentResult::ok : PresentResult::failed;
+    }
+
+    PlatformEvents poll_events() override { return {}; }
+
+    bool recover() override {
+        release_context();
+        try {
+            create_context();
+        } catch (const std::exception&) {
+            return false;
+        }
+        return true;
+    }
+
+    void read_pixels(std::vector<std::uint8_t>& rgba) override {
+        const size_t row = static_cast<size_t>(options_.width) * 4;
+        rgba.resize(row * static_cast<size_t>(options_.height));
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, resolved_.framebuffer);
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glReadPixels(0, 0, options_.width, options_.height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+        // GL's first row is the bottom one; images start at the top.
+        for (size_t top = 0, bottom = static_cast<size_t>(options_.height) - 1; top < bottom; ++top, --bottom)
+            std::swap_ranges(rgba.begin() + static_cast<std::ptrdiff_t>(top * row),
+                             rgba.begin() + static_cast<std::ptrdiff_t>((top + 1) * row),
+                             rgba.begin() + static_cast<std::ptrdiff_t>(bottom * row));
+    }
+
+    std::string description() const override { return "headless (" + which_ + ") " + egl_ + ", " + gl_; }
+
+private:
+    void create_context() {
+        const EGLConfig config = choose_gles3_config(display_, 0, 0, "headless");
+        context_ = create_gles3_context(display_, config, "headless");
+        if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_))
+            throw PlatformError(std::string("headless platform: eglMakeCurrent without a surface failed (") +
+                                egl_error_name(eglGetError()) + ")");
+        gl_ = gl_description();
+        draw_.create(options_.width, options_.height, options_.msaa_samples);
+        resolved_.create(options_.width, options_.height, 0);
+    }
+
+    void release_context() {
+        if (context_ == EGL_NO_CONTEXT) return;
+        if (eglGetCurrentContext() == context_) {
+            draw_.destroy();
+            resolved_.destroy();
+        } else {
+            draw_.abandon();
+            resolved_.abandon();
+        }
+        eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+        eglDestroyContext(display_, context_);
+        context_ = EGL_NO_CONTEXT;
+    }
+
+    PlatformOptions options_;
+    EGLDisplay display_ = EGL_NO_DISPLAY;
+    EGLContext context_ = EGL_NO_CONTEXT;
+    RenderTarget draw_;
+    RenderTarget resolved_;
+    std::string which_;
+    std::string egl_;
+    std::string gl_;
+};
+}  // namespace
+
+std::unique_ptr<Platform> open_headless_platform(const PlatformOptions& options) {
+    return std::make_unique<HeadlessPlatform>(options);
+}
+
+}  // namespace marionette::render

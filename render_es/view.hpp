@@ -1,0 +1,53 @@
+#pragma once
+// The renderer as the pipeline's render thread drives it: open a platform and a
+// renderer once, then per display refresh frame(state, overlay, hud) draws and
+// presents. It never touches the simulation: the caller hands it an already
+// interpolated copy of the state (interpolate.hpp). A failed present or a lost
+// context is reported in the result and recovered by recreating the context and
+// every GL resource; only a failed recovery is fatal.
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "render_es/overlay.hpp"
+#include "render_es/platform.hpp"
+#include "render_es/renderer.hpp"
+
+namespace marionette::render {
+
+struct FrameResult {
+    PresentResult present = PresentResult::ok;
+    bool recovered = false;      // the context or surface was rebuilt this frame
+    PlatformEvents events;
+};
+
+class View {
+public:
+    // Throws PlatformError or ShaderError.
+    View(const PlatformOptions& platform, const RenderSettings& settings, const Skeleton& skeleton, const Terrain& terrain);
+
+    // Polls events (applying the overlay toggles), draws, presents. Throws
+    // PlatformError only when recovery from a lost context fails.
+    FrameResult frame(const PuppetState& state, const DebugOverlay& overlay, std::string_view hud_text, float dt_s);
+
+    // The last presented frame as a PNG. Throws std::runtime_error.
+    void screenshot(const std::string& path);
+
+    Platform& platform() { return *platform_; }
+    Renderer& renderer() { return *renderer_; }
+    std::uint64_t recoveries() const { return recoveries_; }
+
+private:
+    std::unique_ptr<Platform> platform_;
+    std::unique_ptr<Renderer> renderer_;
+    std::uint64_t recoveries_ = 0;
+    std::vector<std::uint8_t> pixels_;
+};
+
+// Heuristic foot markers from a state alone (for logs and sims without a gait
+// overlay): each foot's ankle projected to the ground, in contact when the ankle
+// is within `contact_height_m` of the ground's height plus the ankle height.
+void feet_overlay_from_state(const PuppetState& state, const Terrain& terrain, float ankle_height_m,
+                             DebugOverlay& overlay);
+
+}  // namespace marionette::render

@@ -1,0 +1,212 @@
+// Headless GL tests on Mesa's llvmpipe (surfaceless EGL): golden images of fixed
+// ticks of the shipped programs, shader error reporting, context-loss recovery
+// and an allocation-free frame.
+//
+// Golden images live in tests/render/golden/. After an intended change to the
+// renderer or the simulation, regenerate them with scripts/update-render-golden.sh
+// (it runs this program with MARIONETTE_UPDATE_RENDER_GOLDEN=1) and look at them.
+#include <catch2/catch.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "app/config.hpp"
+#include "app/program_source.hpp"
+#include "app/render_config.hpp"
+#include "app/replay.hpp"
+#include "render_es/gl_util.hpp"
+#include "render_es/image.hpp"
+#include "render_es/view.hpp"
+#include "runtime/puppet.hpp"
+#include "tests/test_support.hpp"
+
+namespace marionette::test {
+std::uint64_t allocation_count();  // alloc_counter.cpp
+}
+
+using namespace marionette;
+
+namespace {
+constexpr std::int32_t kGoldenWidth = 320;
+constexpr std::int32_t kGoldenHeight = 200;
+constexpr int kChannelTolerance = 24;        // llvmpipe versions round a little differently
+constexpr double kMaxDifferingFraction = 0.01;
+
+// The states of the given ticks of a shipped program's recorded log, replayed
+// exactly as `marionette render` replays it.
+struct Replayed {
+    std::vector<PuppetState> states;
+    Skeleton skeleton;
+    float ankle_height = 0.0f;
+};
+Replayed replay_ticks(const std::string& program, std::vector<std::uint64_t> ticks) {
+    const SimConfig config = default_config();
+    Simulation sim(config);
+    InputLogHeader header;
+    header.tick_rate_hz = static_cast<std::uint32_t>(config.tick_rate_hz);
+    header.clip_data_hash = sim.clip_data_hash();
+    header.config_text = serialize_config(config);
+    const DecodedInputLog log = decode_input_log(
+        encode_input_log(header, render_stick_program(load_program("builtin:" + program), config.tick_rate_hz), 60), program);
+    Replayed out;
+    ReplayOptions options;
+    options.on_tick = [&](const Simulation& s) {
+        if (out.skeleton.joint_count() == 0) out.skeleton = s.skeleton();
+        out.ankle_height = s.config().ankle_height;
+        for (std::uint64_t t : ticks)
+            if (s.state().tick == t) out.states.push_back(s.state());
+        return s.state().tick < ticks.back();
+    };
+    replay_log(log, program, options);
+    REQUIRE(out.states.size() == ticks.size());
+    return out;
+}
+
+render::PlatformOptions golden_platform() {
+    render::PlatformOptions p;
+    p.kind = render::PlatformKind::headless;
+    p.width = kGoldenWidth;
+    p.height = kGoldenHeight;
+    p.msaa_samples = 4;
+    return p;
+}
+
+render::Image snapshot(render::View& view) {
+    render::Image image{view.platform().width(), view.platform().height(), {}};
+    view.platform().read_pixels(image.rgba);
+    return image;
+}
+
+void check_golden(const std::string& name, const render::Image& actual) {
+    const std::string golden = test::source_path("tests/render/golden/" + name + ".png");
+    const char* update = std::getenv("MARIONETTE_UPDATE_RENDER_GOLDEN");
+    if (update && std::string(update) == "1") {
+        render::write_png(golden, actual);
+        WARN("rewrote " << golden);
+        return;
+    }
+    REQUIRE(std::filesystem::exists(golden));
+    const render::Image expected = render::read_png(golden);
+    const render::ImageDifference d = render::compare_images(expected, actual, kChannelTolerance);
+    INFO(name << ": " << d.differing_pixels << " pixels (" << 100.0 * d.differing_fraction
+              << " %) differ by more than " << kChannelTolerance << "; largest channel difference " << d.max_channel_difference);
+    if (!d.same_size || d.differing_fraction > kMaxDifferingFraction) {
+        std::filesystem::create_directories("render_failures");
+        render::write_png("render_failures/" + name + ".actual.png", actual);
+        if (d.same_size) render::write_png("render_failures/" + name + ".diff.png", d.diff);
+        WARN("wrote render_failures/" << name << ".actual.png and .diff.png in " << std::filesystem::current_path());
+    }
+    REQUIRE(d.same_size);
+    CHECK(d.differing_fraction <= kMaxDifferingFraction);
+}
+
+Terrain test_steps() {
+    // Three 15 cm steps and a ramp beside the puppet's standing spot.
+    Terrain t;
+    for (int i = 0; i < 3; ++i)
+        t.boxes.push_back({0.6f, 0.4f + 0.3f * static_cast<float>(i), 1.6f, 2.2f, 0.15f * static_cast<float>(i + 1)});
+    t.slopes.push_back({-1.6f, 0.4f, -0.8f, 2.2f, 0.0f, 0.0f, 0.25f});
+    return t;
+}
+}  // namespace
+
+TEST_CASE("golden images: walk_stop mid-stride and circle with skeleton and foot overlays", "[render][golden]") {
+    const RenderConfig rc = load_render_config("");
+    render::RenderSettings settings = rc.settings;
+    settings.show_hud = false;  // text is checked by the CLI frames, not pixel by pixel
+    {
+        const Replayed r = replay_ticks("walk_stop", {600});
+        render::View view(golden_platform(), settings, r.skeleton, Terrain{});
+        view.frame(r.states[0], render::DebugOverlay{}, "", 1.0f / 60.0f);
+        check_golden("walk_stop_t600", snapshot(view));
+    }
+    {
+        const Replayed r = replay_ticks("circle", {900});
+        render::RenderSettings with_overlays = settings;
+        with_overlays.show_skeleton = true;
+        with_overlays.show_feet = true;
+        render::View view(golden_platform(), with_overlays, r.skeleton, Terrain{});
+        render::DebugOverlay overlay;
+        render::feet_overlay_from_state(r.states[0], Terrain{}, r.ankle_height, overlay);
+        view.frame(r.states[0], overlay, "", 1.0f / 60.0f);
+        check_golden("circle_t900_overlays", snapshot(view));
+    }
+}
+
+TEST_CASE("golden image: steps and a ramp are shaded so each face reads", "[render][golden]") {
+    const Replayed r = replay_ticks("stand_still", {240});
+    render::RenderSettings settings = load_render_config("").settings;
+    settings.show_hud = false;
+    render::View view(golden_platform(), settings, r.skeleton, test_steps());
+    view.frame(r.states[0], render::DebugOverlay{}, "", 1.0f / 60.0f);
+    const render::Image image = snapshot(view);
+    check_golden("stand_still_t240_steps", image);
+}
+
+TEST_CASE("the HUD draws text into the top-left corner", "[render][hud]") {
+    const Replayed r = replay_ticks("stand_still", {10});
+    render::RenderSettings settings;
+    render::View view(golden_platform(), settings, r.skeleton, Terrain{});
+    view.frame(r.states[0], render::DebugOverlay{}, "", 0.0f);
+    const render::Image without = snapshot(view);
+    view.frame(r.states[0], render::DebugOverlay{}, "HUD 123", 0.0f);
+    const render::Image with = snapshot(view);
+    const render::ImageDifference d = render::compare_images(without, with, 8);
+    CHECK(d.differing_pixels > 50);
+    // Every differing pixel is inside the HUD panel (top-left).
+    for (std::int32_t y = 0; y < with.height; ++y)
+        for (std::int32_t x = 0; x < with.width; ++x) {
+            const std::size_t i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(with.width) + static_cast<std::size_t>(x)) * 4;
+            if (d.diff.rgba[i] == 255 && d.diff.rgba[i + 1] == 0) REQUIRE((x < 80 && y < 24));
+        }
+}
+
+TEST_CASE("shader compile and link errors name the shader and carry its log", "[render][shader]") {
+    render::View view(golden_platform(), render::RenderSettings{}, make_puppet_skeleton(SimConfig{}), Terrain{});
+    const char* vs = "#version 300 es\nvoid main() { gl_Position = vec4(0.0); }\n";
+    const char* bad_fs = "#version 300 es\nprecision mediump float;\nout vec4 c;\nvoid main() { c = undefined_thing; }\n";
+    try {
+        render::build_program("broken_example", vs, bad_fs);
+        FAIL("a broken shader compiled");
+    } catch (const render::ShaderError& e) {
+        const std::string what = e.what();
+        CHECK(what.find("shader broken_example (fragment) failed to compile") != std::string::npos);
+        CHECK(what.find("undefined_thing") != std::string::npos);  // the compiler's log
+    }
+    // Links fail when stages disagree: the fragment shader reads a varying nobody writes.
+    const char* needs_varying = "#version 300 es\nprecision mediump float;\nin vec3 v_missing;\nout vec4 c;\nvoid main() { c = vec4(v_missing, 1.0); }\n";
+    CHECK_THROWS_WITH(render::build_program("mismatched_example", vs, needs_varying),
+                      Catch::Contains("shader mismatched_example (program) failed to link"));
+}
+
+TEST_CASE("after a lost context the view rebuilds everything and draws the same frame", "[render][recovery]") {
+    const Replayed r = replay_ticks("walk_stop", {700});
+    render::RenderSettings settings;
+    settings.camera.smoothing_s = 0.0f;
+    render::View view(golden_platform(), settings, r.skeleton, test_steps());
+    view.frame(r.states[0], render::DebugOverlay{}, "recovery", 0.0f);
+    const render::Image before = snapshot(view);
+    // What View::frame does when present() reports a lost context.
+    REQUIRE(view.platform().recover());
+    view.platform().begin_frame();
+    view.renderer().recreate();
+    view.frame(r.states[0], render::DebugOverlay{}, "recovery", 0.0f);
+    const render::Image after = snapshot(view);
+    const render::ImageDifference d = render::compare_images(before, after, 0);
+    CHECK(d.differing_pixels == 0);
+}
+
+TEST_CASE("a frame allocates nothing once the view is open", "[render][alloc]") {
+    const Replayed r = replay_ticks("circle", {400, 401, 402, 403});
+    render::RenderSettings settings;
+    settings.show_skeleton = settings.show_feet = settings.show_gait = true;
+    render::View view(golden_platform(), settings, r.skeleton, test_steps());
+    render::DebugOverlay overlay;
+    overlay.foot_count = 1;
+    overlay.feet[0].spline_points = 8;
+    for (const PuppetState& s : r.states) view.frame(s, overlay, "warm-up", 1.0f / 60.0f);  // shaders JIT-compile here
+    const std::uint64_t before = test::allocation_count();
+    for (int i = 0; i < 8; ++i)
+        for (const PuppetState& s : r.states) view.frame(s, overlay, "tick 123  speed 1.00 m/s", 1.0f / 60.0f);
+    CHECK(test::allocation_count() - before == 0);
+}
