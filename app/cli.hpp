@@ -21,5 +21,6 @@ void register_clip_commands(CLI::App& app, int& exit_code);  // clip info, clip 
 void register_render_command(CLI::App& app, int& exit_code); // render (offline frames)
 void register_input_commands(CLI::App& app, int& exit_code);  // input list|monitor|decode, sim-pad
 void register_graph_commands(CLI::App& app, int& exit_code); // graph build, info, path
+void register_gait_eval_command(CLI::App& app, int& exit_code);  // gait-eval
 
 }  // namespace marionette

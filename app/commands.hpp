@@ -10,6 +10,7 @@ struct RunOptions {
     std::string config_file;
     std::string input = "auto";              // auto|evdev|hidapi|sdl|sim:PROGRAM|log:FILE
     std::string display = "auto";
+    std::string render_config_file;          // render settings (config/render.toml overrides)
     std::string record_file;
     std::string trace_file;
     std::string stats_json;

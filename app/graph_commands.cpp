@@ -14,6 +14,7 @@
 #include "app/config.hpp"
 #include "app/embedded.hpp"
 #include "app/files.hpp"
+#include "render_es/image.hpp"
 #include "app/graph_files.hpp"
 #include "app/json.hpp"
 #include "motion_graph/graph_builder.hpp"
@@ -106,10 +107,17 @@ void write_plot(const std::string& path, const graph::GraphBuildOutput& out) {
                 p[2] = 0;
             }
     }
-    render::Image image;  // the renderer's PNG writer (one stb_image_write in the program)
-    image.width = image.height = size;
-    image.rgba.reserve(rgb.size() / 3 * 4);
-    for (size_t p = 0; p < rgb.size(); p += 3) image.rgba.insert(image.rgba.end(), {rgb[p], rgb[p + 1], rgb[p + 2], 255});
+    // One PNG writer in the project (render_es/image.hpp, stb_image_write).
+    render::Image image;
+    image.width = size;
+    image.height = size;
+    image.rgba.resize(static_cast<size_t>(size) * static_cast<size_t>(size) * 4);
+    for (size_t i = 0, n_px = static_cast<size_t>(size) * static_cast<size_t>(size); i < n_px; ++i) {
+        image.rgba[i * 4 + 0] = rgb[i * 3 + 0];
+        image.rgba[i * 4 + 1] = rgb[i * 3 + 1];
+        image.rgba[i * 4 + 2] = rgb[i * 3 + 2];
+        image.rgba[i * 4 + 3] = 255;
+    }
     render::write_png(path, image);
 }
 

@@ -15,6 +15,8 @@
 #include "app/files.hpp"
 #include "app/realtime.hpp"
 #include "app/replay.hpp"
+#include "render_es/interpolate.hpp"
+#include "render_es/view.hpp"
 #include "runtime/det_math.hpp"
 #include "runtime/fixed_step.hpp"
 
@@ -77,6 +79,7 @@ void SimulationLoop::run_tick(std::int64_t tick_time_ns, std::int64_t now_ns) {
     const PuppetState& now = sim_.state();
     frame.current = now;
     frame.current_time_ns = tick_time_ns;
+    frame.connected = assembler_.connected();
     frame.tick_ns = 1'000'000'000 / sim_.config().tick_rate_hz;
     shared_.states.publish();
 
@@ -261,20 +264,83 @@ void simulation_thread(PipelineShared& sh, SimulationLoop& loop, std::uint64_t t
     sh.simulation_done.store(true, std::memory_order_release);
 }
 
-void render_thread(PipelineShared& sh, int frame_rate_hz, std::int64_t t0, bool virtual_time,
-                   FrameTimeHistogram& frame_time) {
+// The GL display, when there is one: made on the render thread (its EGL context
+// is current there), which reports how that went before the run starts.
+struct DisplayThreadState {
+    enum : int { opening, ready, failed };
+    std::atomic<int> state{opening};
+    std::string error;        // failed: why (written before `state`)
+    std::string description;  // ready: the platform
+    std::atomic<bool> closed{false};
+};
+
+struct RenderInputs {
+    const DisplayOptions* display = nullptr;
+    const Skeleton* skeleton = nullptr;
+    const Terrain* terrain = nullptr;
+    float ankle_height = 0.08f;
+    int tick_rate_hz = 240;
+};
+
+void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, RenderInputs in,
+                   DisplayThreadState& display, FrameTimeHistogram& frame_time) {
     FrameLoop frames(sh);
+    std::unique_ptr<render::View> view;
+    if (in.display->gl) {
+        try {
+            view = std::make_unique<render::View>(in.display->platform, in.display->settings, *in.skeleton, *in.terrain);
+            display.description = view->platform().description();
+            display.state.store(DisplayThreadState::ready, std::memory_order_release);
+        } catch (const std::exception& e) {
+            display.error = e.what();
+            display.state.store(DisplayThreadState::failed, std::memory_order_release);
+            return;
+        }
+    } else {
+        display.state.store(DisplayThreadState::ready, std::memory_order_release);
+    }
+    // Everything a GL frame needs, made once.
+    PuppetState drawn{};
+    render::DebugOverlay overlay{};
+    std::array<char, 256> hud{};
+    const bool paced_by_display = view && view->platform().kind() != render::PlatformKind::headless &&
+                                  in.display->platform.vsync;
     const std::int64_t period = 1'000'000'000 / frame_rate_hz;
-    std::int64_t deadline = t0 + period;
+    std::int64_t deadline = monotonic_ns() + period;
     std::int64_t window_max = 0;
     std::uint64_t count = 0;
     std::uint64_t missed = 0;
     volatile float sink = 0.0f;  // keeps the headless frame's work from being optimised away
     while (!sh.stop.load(std::memory_order_relaxed) && !sh.simulation_done.load(std::memory_order_acquire)) {
-        if (!sleep_until_ns_or_stop(virtual_time ? monotonic_ns() + 1'000'000 : deadline, sh.stop)) break;
+        // A window or KMS presents on vblank, which paces us; else our own deadline does.
+        if (!(paced_by_display && frames.has_state()) &&
+            !sleep_until_ns_or_stop(virtual_time ? monotonic_ns() + 1'000'000 : deadline, sh.stop))
+            break;
         const std::int64_t start = monotonic_ns();
         const std::int64_t at = virtual_time ? sh.states.front().current_time_ns : start;
         sink = sink + frames.run_frame(at).x;
+        if (view && frames.has_state()) {
+            const StateFrame& pair = frames.state_pair();
+            render::interpolate_state(pair.previous, pair.current, static_cast<float>(frames.alpha()), drawn);
+            render::feet_overlay_from_state(drawn, *in.terrain, in.ankle_height, overlay);
+            const PipelineCounters& c = sh.counters;
+            const float speed = std::sqrt(drawn.velocity.x * drawn.velocity.x + drawn.velocity.y * drawn.velocity.y);
+            // The stats overlay, formatted into fixed space (no allocation in the frame).
+            const auto n = fmt::format_to_n(
+                hud.data(), hud.size() - 1,
+                "t {:.1f} s  {:.2f} m/s{}  tick max {:.0f} us  input->tick max {:.1f} ms  dropped {}  missed frames {}",
+                static_cast<double>(drawn.tick) / in.tick_rate_hz, speed,
+                frames.state_pair().connected ? "" : "  [no controller: idling]",
+                c.tick_time_max_ns.load(std::memory_order_relaxed) / 1e3,
+                c.input_latency_max_ns.load(std::memory_order_relaxed) / 1e6,
+                c.samples_dropped.load(std::memory_order_relaxed), c.missed_frames.load(std::memory_order_relaxed));
+            const render::FrameResult r = view->frame(drawn, overlay, std::string_view(hud.data(), n.size),
+                                                      static_cast<float>(period) / 1e9f);
+            if (r.events.close_requested) {
+                display.closed.store(true, std::memory_order_release);
+                break;
+            }
+        }
         const std::int64_t end = monotonic_ns();
         frame_time.add(end - start);
         if (end - start > window_max) window_max = end - start;
@@ -427,17 +493,29 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
     sigaddset(&stop_signals, SIGTERM);
     pthread_sigmask(SIG_BLOCK, &stop_signals, &previous_mask);
 
-    const std::int64_t wall_start = monotonic_ns();
-    const std::int64_t t0 = o.virtual_time ? 0 : wall_start + 20'000'000;  // let the threads start first
     SimulationThreadResult sim_result;
+    DisplayThreadState display;
+    RenderInputs render_inputs{&o.display, &loop->simulation().skeleton(), &loop->simulation().terrain(),
+                               config.ankle_height, config.tick_rate_hz};
     std::thread sim_thread, in_thread, gfx_thread;
     ThreadGuard guard{{&sim_thread, &in_thread, &gfx_thread}, sh};
+    std::int64_t wall_start = 0;
     try {
+        // The render thread first: the display must open before the clock starts.
+        gfx_thread = std::thread(render_thread, std::ref(sh), o.frame_rate_hz, o.virtual_time, render_inputs,
+                                 std::ref(display), std::ref(result.frame_time));
+        while (display.state.load(std::memory_order_acquire) == DisplayThreadState::opening)
+            sleep_until_ns(monotonic_ns() + 1'000'000);
+        if (display.state.load(std::memory_order_acquire) == DisplayThreadState::failed) {
+            gfx_thread.join();
+            throw render::PlatformError(display.error);
+        }
+        result.display_description = display.description;
+        wall_start = monotonic_ns();
+        const std::int64_t t0 = o.virtual_time ? 0 : wall_start + 20'000'000;  // let the threads start first
         sim_thread = std::thread(simulation_thread, std::ref(sh), std::ref(*loop), o.total_ticks, t0, o.virtual_time,
                                  !o.script.stamp_when_read, std::ref(sim_result));
         in_thread = std::thread(input_thread, std::ref(sh), std::cref(o.script), t0, o.virtual_time);
-        gfx_thread = std::thread(render_thread, std::ref(sh), o.frame_rate_hz, t0, o.virtual_time,
-                                 std::ref(result.frame_time));
     } catch (...) {
         pthread_sigmask(SIG_SETMASK, &previous_mask, nullptr);
         throw;
@@ -530,6 +608,10 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
         if (stop_seen < 0 && o.stop_request && o.stop_request->load()) {
             stop_seen = now;
             result.stopped = true;
+            sh.stop.store(true);
+        }
+        if (!result.display_closed && display.closed.load(std::memory_order_acquire)) {
+            result.display_closed = true;  // closing the window ends the run normally
             sh.stop.store(true);
         }
         if (tuning.watcher) {

@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "render_es/platform.hpp"
+#include "render_es/settings.hpp"
 #include "runtime/input_log.hpp"
 #include "runtime/latency_histogram.hpp"
 #include "runtime/latest_value.hpp"
@@ -39,6 +41,7 @@ struct StateFrame {
     PuppetState current;
     std::int64_t current_time_ns = 0;  // when `current`'s tick was due
     std::int64_t tick_ns = 0;
+    bool connected = true;             // the controller, for the on-screen notice
 };
 
 // Simulation → writer, per tick (and per configuration change, in order).
@@ -145,6 +148,8 @@ public:
     vec3 run_frame(std::int64_t frame_time_ns);
     bool has_state() const { return has_state_; }
     double alpha() const { return alpha_; }
+    // The state pair the last run_frame() interpolated (valid once has_state()).
+    const StateFrame& state_pair() const { return shared_.states.front(); }
     const std::array<vec3, kMaxJoints>& joints() const { return joints_; }
 
 private:
@@ -181,6 +186,15 @@ InputScript script_from_log(const DecodedInputLog& log, std::int64_t tick_ns);
 using TickTimeHistogram = DurationHistogram<1'000, 2048>;     // 1 µs buckets, ≤ 2 ms
 using FrameTimeHistogram = DurationHistogram<1'000, 4096>;    // 1 µs buckets, ≤ 4 ms
 
+// What the render thread draws on. Without `gl` it runs the headless frame loop
+// (interpolation only, no GPU); with it, render_es draws every frame in a
+// window or on KMS (render_es/view.hpp), presenting paced by the display.
+struct DisplayOptions {
+    bool gl = false;
+    render::PlatformOptions platform;
+    render::RenderSettings settings;
+};
+
 struct PipelineOptions {
     SimConfig config;
     InputScript script;
@@ -190,6 +204,7 @@ struct PipelineOptions {
     // waiting for every sample up to its time, so the run is deterministic.
     bool virtual_time = false;
     int frame_rate_hz = 60;            // the headless frame loop's pace
+    DisplayOptions display;
     std::string record_file;           // input log ("" = none)
     std::string trace_file;            // per-tick CSV ("" = none)
     std::string watch_config_file;     // live tuning ("" = none)
@@ -223,10 +238,13 @@ struct PipelineResult {
     std::uint64_t disconnects = 0;
     std::uint64_t reconnects = 0;
     std::string realtime_warning;       // what the [realtime] settings could not do
+    bool display_closed = false;        // the window was closed (ends the run)
+    std::string display_description;    // the GL platform, when one was used
 };
 
-// Runs the whole pipeline until total_ticks have run or a stop is requested.
-// Throws std::runtime_error when an output cannot be created or written.
+// Runs the whole pipeline until total_ticks have run, a stop is requested or the
+// window is closed. Throws std::runtime_error when an output cannot be created
+// or written, render::PlatformError when the display cannot be opened.
 PipelineResult run_pipeline(const PipelineOptions& options);
 
 }  // namespace marionette

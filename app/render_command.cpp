@@ -129,7 +129,7 @@ int render_command(const RenderCommandOptions& o) {
     platform.width = rc.settings.width;
     platform.height = rc.settings.height;
     platform.msaa_samples = rc.settings.msaa_samples;
-    const Terrain terrain;  // flat ground until logs carry a terrain
+    const Terrain* terrain = nullptr;  // the replayed simulation's
 
     std::unique_ptr<render::View> view;
     std::unique_ptr<VideoPipe> video;
@@ -143,7 +143,7 @@ int render_command(const RenderCommandOptions& o) {
     const auto started = std::chrono::steady_clock::now();
 
     auto draw_frame = [&](const PuppetState& state, double seconds) {
-        render::feet_overlay_from_state(state, terrain, static_cast<float>(ankle_height), overlay);
+        render::feet_overlay_from_state(state, *terrain, static_cast<float>(ankle_height), overlay);
         const float speed = std::sqrt(state.velocity.x * state.velocity.x + state.velocity.y * state.velocity.y);
         const std::string hud = fmt::format("{}  t {:.2f} s  tick {}  speed {:.2f} m/s  heading {:.0f} deg",
                                             std::filesystem::path(o.log_file).filename().string(), seconds, state.tick,
@@ -164,7 +164,8 @@ int render_command(const RenderCommandOptions& o) {
         if (!view) {
             tick_rate = sim.config().tick_rate_hz;
             ankle_height = sim.config().ankle_height;
-            view = std::make_unique<render::View>(platform, rc.settings, sim.skeleton(), terrain);
+            terrain = &sim.terrain();
+            view = std::make_unique<render::View>(platform, rc.settings, sim.skeleton(), *terrain);
             if (!ffmpeg.empty()) video = std::make_unique<VideoPipe>(ffmpeg, o.video, platform.width, platform.height, o.fps);
         }
         // Every frame whose time falls in (previous tick, this tick] is drawn now.

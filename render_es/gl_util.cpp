@@ -144,4 +144,15 @@ void RenderTarget::resolve_to(GLuint target, std::int32_t target_width, std::int
     glBindFramebuffer(GL_FRAMEBUFFER, target);
 }
 
+void RenderTarget::present_to(GLuint target, std::int32_t target_width, std::int32_t target_height,
+                              RenderTarget& single) const {
+    if (samples == 0) {
+        resolve_to(target, target_width, target_height);
+        return;
+    }
+    if (single.width != width || single.height != height || single.framebuffer == 0) single.create(width, height, 0);
+    resolve_to(single.framebuffer, width, height);
+    single.resolve_to(target, target_width, target_height);
+}
+
 }  // namespace marionette::render

@@ -40,6 +40,10 @@ struct RenderTarget {
     // Forgets the GL names without deleting them (their context is gone).
     void abandon() { *this = RenderTarget{}; }
     void resolve_to(GLuint target, std::int32_t target_width, std::int32_t target_height) const;
+    // Copies the frame to `target` (a window's framebuffer 0): a multisampled
+    // target resolves into `single` (same RGBA8 format, (re)created as needed)
+    // first, since GLES forbids a multisample resolve into a different format.
+    void present_to(GLuint target, std::int32_t target_width, std::int32_t target_height, RenderTarget& single) const;
 };
 
 // Clamps a requested MSAA sample count to what the context supports (0 = off).

@@ -120,6 +120,9 @@ public:
     // Resolves MSAA and shows the frame: a buffer swap (vsync-paced in a window),
     // a page flip on the next vblank (KMS), nothing for headless.
     virtual PresentResult present() = 0;
+    // Leaves the context current on no thread, so another thread's begin_frame()
+    // can take it (a display opened on the main thread, drawn by the render thread).
+    virtual void release_current() = 0;
     // Drains window/input events without blocking.
     virtual PlatformEvents poll_events() = 0;
     // After context_lost or a failed present: rebuilds the context and surface.

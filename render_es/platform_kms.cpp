@@ -228,7 +228,7 @@ public:
     }
 
     PresentResult present() override {
-        draw_.resolve_to(0, width(), height());
+        draw_.present_to(0, width(), height(), resolved_);
         if (!eglSwapBuffers(egl_display_, surface_))
             return eglGetError() == EGL_CONTEXT_LOST ? PresentResult::context_lost : PresentResult::failed;
         if (glGetError() == kGlContextLost) return PresentResult::context_lost;
@@ -256,6 +256,8 @@ public:
         return PresentResult::ok;
     }
 
+    void release_current() override { eglMakeCurrent(egl_display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT); }
+
     PlatformEvents poll_events() override {
         PlatformEvents e;
         if (seat_.seat != nullptr) libseat_dispatch(seat_.seat, 0);  // VT switches
@@ -275,7 +277,8 @@ public:
     void read_pixels(std::vector<std::uint8_t>& rgba) override {
         const size_t row = static_cast<size_t>(width()) * 4;
         rgba.resize(row * static_cast<size_t>(height()));
-        if (resolved_.width != width() || resolved_.height != height()) resolved_.create(width(), height(), 0);
+        if (resolved_.width != width() || resolved_.height != height() || resolved_.framebuffer == 0)
+            resolved_.create(width(), height(), 0);
         draw_.resolve_to(resolved_.framebuffer, width(), height());
         glBindFramebuffer(GL_READ_FRAMEBUFFER, resolved_.framebuffer);
         glPixelStorei(GL_PACK_ALIGNMENT, 1);

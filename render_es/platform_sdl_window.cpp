@@ -62,12 +62,12 @@ public:
     }
 
     PresentResult present() override {
-        draw_.resolve_to(0, width_, height_);
+        draw_.present_to(0, width_, height_, resolved_);
         SDL_GL_SwapWindow(window_);  // blocks until vblank with vsync: this is the pacing
-        const GLenum error = glGetError();
-        if (error == kGlContextLost) return PresentResult::context_lost;
-        return error == GL_NO_ERROR ? PresentResult::ok : PresentResult::failed;
+        return glGetError() == kGlContextLost ? PresentResult::context_lost : PresentResult::ok;
     }
+
+    void release_current() override { SDL_GL_MakeCurrent(window_, nullptr); }
 
     PlatformEvents poll_events() override {
         PlatformEvents e;
@@ -111,7 +111,8 @@ public:
     void read_pixels(std::vector<std::uint8_t>& rgba) override {
         // The window's back buffer is undefined after the swap; the frame is still
         // in the draw target, so resolve that into a single-sample copy and read it.
-        if (resolved_.width != width_ || resolved_.height != height_) resolved_.create(width_, height_, 0);
+        if (resolved_.width != width_ || resolved_.height != height_ || resolved_.framebuffer == 0)
+            resolved_.create(width_, height_, 0);
         draw_.resolve_to(resolved_.framebuffer, width_, height_);
         const size_t row = static_cast<size_t>(width_) * 4;
         rgba.resize(row * static_cast<size_t>(height_));

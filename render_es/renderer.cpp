@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdio>
 #include <cstring>
 
 #include "render_es/gl_util.hpp"
@@ -229,7 +230,28 @@ void Renderer::draw(const PuppetState& state, const DebugOverlay& overlay, std::
     glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(puppet_.indices.size()), GL_UNSIGNED_SHORT, nullptr);
 
     draw_overlays(state, overlay, view_projection);
-    if (toggles_.hud && !hud_text.empty()) draw_hud(hud_text, width, height);
+    // The motion-graph state is a line of text under the HUD's own, written into
+    // fixed scratch space (no allocation).
+    std::size_t text_length = 0;
+    if (toggles_.hud) {
+        text_length = std::min(hud_text.size(), hud_text_.size() - 1);
+        std::memcpy(hud_text_.data(), hud_text.data(), text_length);
+    }
+    if (toggles_.motion_graph && overlay.motion_graph.valid) {
+        const MotionGraphOverlay& m = overlay.motion_graph;
+        const auto name = [](const std::array<char, kOverlayNameLength>& n) {
+            return std::string_view(n.data(), strnlen(n.data(), n.size()));
+        };
+        const std::string_view clip = name(m.current_clip);
+        const std::string_view next = name(m.next_transition);
+        const int written = std::snprintf(hud_text_.data() + text_length, hud_text_.size() - text_length,
+                                          "%sclip %.*s%s%.*s (%d%%)", text_length ? "\n" : "", static_cast<int>(clip.size()),
+                                          clip.data(), next.empty() ? "" : " -> ", static_cast<int>(next.size()), next.data(),
+                                          static_cast<int>(std::clamp(m.transition_progress, 0.0f, 1.0f) * 100.0f + 0.5f));
+        if (written > 0) text_length = std::min(hud_text_.size() - 1, text_length + static_cast<std::size_t>(written));
+    }
+    hud_text_[text_length] = '\0';
+    if (text_length > 0) draw_hud(width, height);
     glBindVertexArray(0);
 }
 
@@ -270,10 +292,7 @@ void Renderer::draw_overlays(const PuppetState& state, const DebugOverlay& overl
     glEnable(GL_DEPTH_TEST);
 }
 
-void Renderer::draw_hud(std::string_view text, std::int32_t width, std::int32_t height) {
-    const std::size_t n = std::min(text.size(), hud_text_.size() - 1);
-    std::memcpy(hud_text_.data(), text.data(), n);
-    hud_text_[n] = '\0';
+void Renderer::draw_hud(std::int32_t width, std::int32_t height) {
     const float scale = std::max(1.0f, static_cast<float>(height) / 400.0f);
     const auto byte = [](float v) { return static_cast<std::uint8_t>(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f); };
 

@@ -64,7 +64,7 @@ private:
     void add_cross(vec3 p, float size, vec3 colour);
     void add_ring(vec3 centre, float radius, vec3 colour);
     void draw_overlays(const PuppetState& state, const DebugOverlay& overlay, const glm::mat4& view_projection);
-    void draw_hud(std::string_view text, std::int32_t width, std::int32_t height);
+    void draw_hud(std::int32_t width, std::int32_t height);  // hud_text_, NUL-terminated
 
     RenderSettings settings_;
     OverlayToggles toggles_;

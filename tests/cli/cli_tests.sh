@@ -22,7 +22,7 @@ expect_error() {  # expect_error "what" exit_code "message substring" command...
     echo "FAILED: $what (exit $rc, stderr: $(cat err.txt))"; failures=$((failures + 1)); fi
 }
 
-for program in stand_still walk_stop circle demo; do
+for program in stand_still walk_stop circle demo slow_walk fast_walk run start_stop full_circle reversals stop_mid_step; do
   "$bin" record --program "$src/config/programs/$program.prog" -o "$program.mlog" --json >rec.json
   rec_hash=$(sed -E 's/.*"final_hash":"([0-9a-f]+)".*/\1/' rec.json)
   h1=$("$bin" replay "$program.mlog" --hash)

@@ -121,7 +121,6 @@ check "demo: finishes" grep -q "^demo finished" demo.txt
 
 # Errors: exit code 2 and a clear message.
 expect_error "evdev not available" 2 "--input evdev: not available in this build" "$bin" run --input evdev
-expect_error "window not available" 2 "--display window: not available in this build" "$bin" run --display window
 expect_error "unknown input" 2 "expected auto, evdev, hidapi, sdl, sim:PROGRAM or log:FILE" "$bin" run --input joystick
 expect_error "unplug needs the simulated controller" 2 "only the simulated controller" "$bin" run --input log:f1.mlog --sim-unplug 1 1
 expect_error "missing log" 2 "cannot open file" "$bin" run --input log:missing.mlog
@@ -129,6 +128,21 @@ printf 'hold 1s\nwalk 2s\n' >bad.prog
 expect_error "bad program" 2 "bad.prog:2: unknown command 'walk'" "$bin" run --input sim:bad.prog
 printf '[realtime]\ninput_priority = 120\n' >badrt.toml
 expect_error "bad realtime key" 2 "badrt.toml:2: realtime.input_priority: 120 is out of range" "$bin" run --config badrt.toml
+
+# A window (under a virtual X server when one is installed): render_es draws from
+# the render thread; the simulation is unaffected.
+if command -v xvfb-run >/dev/null; then
+  xvfb-run -a "$bin" run --display window --duration 2 --record win.mlog --trace win.csv >win.txt 2>win.err
+  check "window: run exits 0" test $? -eq 0
+  check "window: names the GL platform" grep -q "^display: window" win.txt
+  "$bin" replay win.mlog --trace win_b.csv >/dev/null
+  check "window: --trace equals replay --trace" cmp -s win.csv win_b.csv
+fi
+env -u DISPLAY -u WAYLAND_DISPLAY "$bin" run --display kms --duration 1 >kms.txt 2>kms.err
+rc=$?
+if [[ ! -e /dev/dri/card0 ]]; then
+  check "kms without a DRM device: a clear error" test $rc -eq 1 -a -n "$(grep 'kms platform' kms.err)"
+fi
 
 # Real-time settings that are not permitted: one warning, then a normal run.
 printf '[realtime]\ninput_priority = 80\nsimulation_priority = 80\nrender_priority = 70\nlock_memory = 1\n' >rt.toml

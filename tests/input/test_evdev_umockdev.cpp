@@ -80,9 +80,10 @@ TEST_CASE("evdev under umockdev: input thread reads, survives unplug, picks up a
     CHECK(first->input.buttons == 0);
     // One tick covering all three: latest sticks, and the 1 ms press survives.
     TickInputAssembler assembler;
-    AssemblerStats stats;
-    const TickInput tick = assembler.assemble(ring, std::numeric_limits<std::int64_t>::max() / 2, stats);
-    CHECK(stats.samples == 3);
+    InputLatencyHistogram stats;
+    const std::int64_t tick_time = std::numeric_limits<std::int64_t>::max() / 2;
+    const TickInput tick = assembler.assemble(ring, tick_time, tick_time, stats);
+    CHECK(stats.count == 3);
     CHECK(tick.buttons == button_bit(Button::south));
     CHECK(tick.left_x == quantize_stick(-1.0));
 

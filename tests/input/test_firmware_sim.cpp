@@ -249,15 +249,16 @@ TEST_CASE("in-process: a press shorter than a tick reaches the tick through the 
     }
     CHECK(t == 31'000'000);
     TickInputAssembler assembler;
-    AssemblerStats stats;
+    InputLatencyHistogram stats;
     int ticks_with_east = 0;
     TickInput last{};
     for (int k = 1; k <= 8; ++k) {
-        last = assembler.assemble(ring, static_cast<std::int64_t>(k) * 1'000'000'000 / 240, stats);
+        const std::int64_t tick_time = static_cast<std::int64_t>(k) * 1'000'000'000 / 240;
+        last = assembler.assemble(ring, tick_time, tick_time, stats);
         if (last.buttons & button_bit(Button::east)) ++ticks_with_east;
     }
     CHECK(ticks_with_east == 1);
     // 0.5 is 192 on the wire (64/127 from centre); the deadzone rescales it.
     CHECK(last.left_x == Approx(32767.0 * (64.0 / 127.0 - 0.1) / 0.9).margin(2));
-    CHECK(stats.samples == 31);
+    CHECK(stats.count == 31);
 }

@@ -7,6 +7,7 @@
 // (it runs this program with MARIONETTE_UPDATE_RENDER_GOLDEN=1) and look at them.
 #include <catch2/catch.hpp>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 
@@ -37,6 +38,7 @@ constexpr double kMaxDifferingFraction = 0.01;
 struct Replayed {
     std::vector<PuppetState> states;
     Skeleton skeleton;
+    Terrain terrain;  // the configuration's (config/marionette.toml [terrain])
     float ankle_height = 0.0f;
 };
 Replayed replay_ticks(const std::string& program, std::vector<std::uint64_t> ticks) {
@@ -51,7 +53,10 @@ Replayed replay_ticks(const std::string& program, std::vector<std::uint64_t> tic
     Replayed out;
     ReplayOptions options;
     options.on_tick = [&](const Simulation& s) {
-        if (out.skeleton.joint_count() == 0) out.skeleton = s.skeleton();
+        if (out.skeleton.joint_count() == 0) {
+            out.skeleton = s.skeleton();
+            out.terrain = s.terrain();
+        }
         out.ankle_height = s.config().ankle_height;
         for (std::uint64_t t : ticks)
             if (s.state().tick == t) out.states.push_back(s.state());
@@ -110,13 +115,13 @@ Terrain test_steps() {
 }
 }  // namespace
 
-TEST_CASE("golden images: walk_stop mid-stride and circle with skeleton and foot overlays", "[render][golden]") {
+TEST_CASE("golden images: walk_stop mid-stride on the default terrain, circle with skeleton and foot overlays", "[render][golden]") {
     const RenderConfig rc = load_render_config("");
     render::RenderSettings settings = rc.settings;
     settings.show_hud = false;  // text is checked by the CLI frames, not pixel by pixel
     {
         const Replayed r = replay_ticks("walk_stop", {600});
-        render::View view(golden_platform(), settings, r.skeleton, Terrain{});
+        render::View view(golden_platform(), settings, r.skeleton, r.terrain);
         view.frame(r.states[0], render::DebugOverlay{}, "", 1.0f / 60.0f);
         check_golden("walk_stop_t600", snapshot(view));
     }
@@ -159,6 +164,26 @@ TEST_CASE("the HUD draws text into the top-left corner", "[render][hud]") {
             const std::size_t i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(with.width) + static_cast<std::size_t>(x)) * 4;
             if (d.diff.rgba[i] == 255 && d.diff.rgba[i + 1] == 0) REQUIRE((x < 80 && y < 24));
         }
+}
+
+TEST_CASE("the motion-graph overlay writes the current clip and next transition when toggled on", "[render][hud]") {
+    const Replayed r = replay_ticks("stand_still", {10});
+    render::View view(golden_platform(), render::RenderSettings{}, r.skeleton, Terrain{});
+    render::DebugOverlay overlay;
+    overlay.motion_graph.valid = true;
+    std::snprintf(overlay.motion_graph.current_clip.data(), overlay.motion_graph.current_clip.size(), "walk");
+    std::snprintf(overlay.motion_graph.next_transition.data(), overlay.motion_graph.next_transition.size(), "run");
+    overlay.motion_graph.transition_progress = 0.4f;
+    view.frame(r.states[0], overlay, "", 0.0f);
+    const render::Image off = snapshot(view);
+    view.renderer().toggles().motion_graph = true;
+    view.frame(r.states[0], overlay, "", 0.0f);
+    const render::Image on = snapshot(view);
+    const render::ImageDifference d = render::compare_images(off, on, 8);
+    CHECK(d.differing_pixels > 50);
+    view.renderer().toggles().hud = false;  // the HUD toggle does not hide the motion-graph line
+    view.frame(r.states[0], overlay, "ignored", 0.0f);
+    CHECK(render::compare_images(on, snapshot(view), 0).differing_pixels == 0);
 }
 
 TEST_CASE("shader compile and link errors name the shader and carry its log", "[render][shader]") {
@@ -209,4 +234,24 @@ TEST_CASE("a frame allocates nothing once the view is open", "[render][alloc]") 
     for (int i = 0; i < 8; ++i)
         for (const PuppetState& s : r.states) view.frame(s, overlay, "tick 123  speed 1.00 m/s", 1.0f / 60.0f);
     CHECK(test::allocation_count() - before == 0);
+}
+
+// Hidden from test discovery ([.window]): CTest runs it under xvfb-run (see
+// tests/CMakeLists.txt), where the SDL window platform must draw exactly what the
+// headless one draws.
+TEST_CASE("the SDL window platform draws the golden frame under Xvfb", "[.window]") {
+    REQUIRE(std::getenv("DISPLAY") != nullptr);
+    const Replayed r = replay_ticks("walk_stop", {600});
+    render::RenderSettings settings = load_render_config("").settings;
+    settings.show_hud = false;
+    render::PlatformOptions options = golden_platform();
+    options.kind = render::PlatformKind::window;
+    render::View view(options, settings, r.skeleton, r.terrain);
+    INFO(view.platform().description());
+    REQUIRE(view.platform().width() == kGoldenWidth);
+    REQUIRE(view.platform().height() == kGoldenHeight);
+    const render::FrameResult result = view.frame(r.states[0], render::DebugOverlay{}, "", 1.0f / 60.0f);
+    CHECK(result.present == render::PresentResult::ok);
+    CHECK_FALSE(result.events.close_requested);
+    check_golden("walk_stop_t600", snapshot(view));
 }
