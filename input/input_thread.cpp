@@ -81,6 +81,7 @@ bool InputThread::start(InputRing& ring, const InputThreadOptions& options, std:
                 InputRingWriter<InputRing> writer(ring);
                 std::array<InputSample, kBatch> batch{};
                 const FamilyCalibration& cal = options_.config.family(DeviceFamily::evdev);
+                bool was_connected = backend.connected() > 0;
                 while (!stop_requested_.load(std::memory_order_relaxed)) {
                     const int n = backend.poll(batch, 20);
                     for (int i = 0; i < n; ++i) {
@@ -88,7 +89,12 @@ bool InputThread::start(InputRing& ring, const InputThreadOptions& options, std:
                         apply_calibration(cal, options_.raw, s);
                         if (writer.push(to_timed_input(s))) samples_.fetch_add(1, std::memory_order_relaxed);
                     }
-                    connected_.store(backend.connected() > 0, std::memory_order_release);
+                    const bool now_connected = backend.connected() > 0;
+                    // The last pad left: tell the simulation (the puppet idles).
+                    if (was_connected && !now_connected) writer.push_disconnect(monotonic_now_ns());
+                    writer.flush_pending();
+                    was_connected = now_connected;
+                    connected_.store(now_connected, std::memory_order_release);
                     connects_.store(backend.connects(), std::memory_order_relaxed);
                     disconnects_.store(backend.disconnects(), std::memory_order_relaxed);
                     syn_dropped_.store(backend.syn_dropped(), std::memory_order_relaxed);
@@ -136,6 +142,7 @@ bool InputThread::start(InputRing& ring, const InputThreadOptions& options, std:
                     } else if (r == HidPad::Result::rejected) {
                         rejected_.store(pad.counters().rejected(), std::memory_order_relaxed);
                     } else if (r == HidPad::Result::disconnected) {
+                        writer.push_disconnect(monotonic_now_ns());
                         connected_ = false;
                         disconnects_.fetch_add(1);
                         break;  // the pipeline sees device_connected() == false

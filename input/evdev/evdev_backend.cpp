@@ -95,25 +95,44 @@ void EvdevBackend::scan_directory() {
     for (const std::string& path : event_nodes(dir_)) try_open(path);
 }
 
-void EvdevBackend::try_open(const std::string& path) {
-    if (!only_path_.empty() && path != only_path_) return;
+bool EvdevBackend::try_open(const std::string& path) {
+    if (!only_path_.empty() && path != only_path_) return true;
     int free_slot = -1;
     for (int i = 0; i < kMaxPads; ++i) {
         const auto& p = pads_[static_cast<std::size_t>(i)];
-        if (p && p->path() == path) return;  // already open
+        if (p && p->path() == path) return true;  // already open
         if (!p && free_slot < 0) free_slot = i;
     }
-    if (free_slot < 0) return;
+    if (free_slot < 0) return true;
     std::string error;
     auto pad = EvdevPad::open(path, error);
-    if (!pad) return;
+    if (!pad) return false;
     pad->set_apply_flat(!raw_);
     epoll_event ev{};
     ev.events = EPOLLIN;
     ev.data.u64 = static_cast<std::uint64_t>(free_slot);
-    if (epoll_ctl(epoll_fd_, EPOLL_CTL_ADD, pad->fd(), &ev) < 0) return;
+    if (epoll_ctl(epoll_fd_, EPOLL_CTL_ADD, pad->fd(), &ev) < 0) return false;
     pads_[static_cast<std::size_t>(free_slot)] = std::move(pad);
     ++connects_;
+    return true;
+}
+
+void EvdevBackend::remember_pending(const std::string& path) {
+    // Not openable yet: keep trying for a while (a node that is not a gamepad at
+    // all just times out).
+    for (Pending& p : pending_)
+        if (p.path.empty() || p.path == path) {
+            p.path = path;
+            p.until_ns = monotonic_now_ns() + 2'000'000'000;
+            return;
+        }
+}
+
+void EvdevBackend::retry_pending(std::int64_t now) {
+    for (Pending& p : pending_) {
+        if (p.path.empty()) continue;
+        if (try_open(p.path) || now > p.until_ns) p.path.clear();
+    }
 }
 
 void EvdevBackend::close_slot(int slot) {
@@ -141,8 +160,8 @@ void EvdevBackend::handle_inotify() {
             if (e->mask & IN_DELETE) {
                 for (int i = 0; i < kMaxPads; ++i)
                     if (pads_[static_cast<std::size_t>(i)] && pads_[static_cast<std::size_t>(i)]->path() == path) close_slot(i);
-            } else {
-                try_open(path);
+            } else if (!try_open(path) && (e->mask & IN_CREATE)) {
+                remember_pending(path);
             }
         }
     }
@@ -152,11 +171,23 @@ int EvdevBackend::poll(std::span<InputSample> out, int timeout_ms) {
     epoll_event events[kMaxPads + 1];
     const int n = epoll_wait(epoll_fd_, events, kMaxPads + 1, timeout_ms);
     int produced = 0;
+    bool any_pending = false;
+    for (const Pending& p : pending_) any_pending = any_pending || !p.path.empty();
+    if (any_pending) {
+        const std::int64_t now = monotonic_now_ns();
+        if (now - last_pending_retry_ns_ >= 100'000'000) {
+            last_pending_retry_ns_ = now;
+            retry_pending(now);
+        }
+    }
     if (!watching_ && inotify_fd_ >= 0) {
         const std::int64_t now = monotonic_now_ns();
         if (now - last_watch_retry_ns_ >= kWatchRetryNs) {
             last_watch_retry_ns_ = now;
-            if (add_watch()) scan_directory();
+            // The directory is back: what is in it now arrived while unwatched.
+            if (add_watch())
+                for (const std::string& path : event_nodes(dir_))
+                    if (!try_open(path)) remember_pending(path);
         }
     }
     for (int i = 0; i < n; ++i) {

@@ -50,10 +50,21 @@ public:
 
 private:
     void scan_directory();
-    void try_open(const std::string& path);
+    bool try_open(const std::string& path);
     void close_slot(int slot);
     void handle_inotify();
     bool add_watch();
+    void retry_pending(std::int64_t now);
+    void remember_pending(const std::string& path);
+    // Nodes that appeared but could not be opened yet (udev still setting
+    // permissions, or a test bed still loading the device's ioctls): retried
+    // every 100 ms for 2 s.
+    struct Pending {
+        std::string path;
+        std::int64_t until_ns = 0;
+    };
+    std::array<Pending, kMaxPads> pending_{};
+    std::int64_t last_pending_retry_ns_ = 0;
     static constexpr std::int64_t kWatchRetryNs = 250'000'000;
 
     int epoll_fd_ = -1;

@@ -4,8 +4,8 @@
 # < 1500 °/s; gait-eval --check exits 1 otherwise). Prints the metrics table.
 # Usage: gait_eval_tests.sh MARIONETTE_BINARY SOURCE_DIR
 set -uo pipefail
-bin=$1
-src=$2
+bin=$(realpath "$1")
+src=$(realpath "$2")
 failures=0
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

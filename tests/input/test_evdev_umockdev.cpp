@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "firmware_sim/sim_pad.hpp"
+#include "input/evdev/evdev_pad.hpp"
 #include "input/input_thread.hpp"
 #include "tests/test_support.hpp"
 
@@ -81,7 +82,7 @@ TEST_CASE("evdev under umockdev: input thread reads, survives unplug, picks up a
     // One tick covering all three: latest sticks, and the 1 ms press survives.
     TickInputAssembler assembler;
     InputLatencyHistogram stats;
-    const std::int64_t tick_time = std::numeric_limits<std::int64_t>::max() / 2;
+    const std::int64_t tick_time = monotonic_now_ns() + 1'000'000'000;
     const TickInput tick = assembler.assemble(ring, tick_time, tick_time, stats);
     CHECK(stats.count == 3);
     CHECK(tick.buttons == button_bit(Button::south));
@@ -91,6 +92,11 @@ TEST_CASE("evdev under umockdev: input thread reads, survives unplug, picks up a
     umockdev_testbed_remove_device(bed, "/sys/devices/pci0000:00/0000:00:14.0/usb1/1-1/1-1:1.0/input/input7/event7");
     CHECK(wait_for([&] { return !thread.device_connected(); }, 3.0));
     CHECK(thread.stats().disconnects == 1);
+    // ... and tells the simulation through the ring: a disconnect marker.
+    REQUIRE(wait_for([&] { return ring.peek() != nullptr; }, 1.0));
+    CHECK_FALSE(ring.peek()->connected);
+    CHECK(assembler.assemble(ring, monotonic_now_ns(), monotonic_now_ns(), stats) == TickInput{});
+    CHECK_FALSE(assembler.connected());
 
     // Plug in again: the kernel gives the new pad a new node.
     const std::string replugged = replace_all(replace_all(replace_all(description, "event7", "event8"), "input7", "input8"),

@@ -3,6 +3,8 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstdlib>
+#include <new>
 #include <set>
 
 #include "firmware_sim/faults.hpp"
@@ -17,6 +19,27 @@
 using namespace marionette;
 using namespace marionette::input;
 namespace fs = marionette::firmware_sim;
+
+// Every allocation in this test program is counted, so a test can prove a hot
+// path allocates nothing. Not under AddressSanitizer, which owns operator new
+// (memory from the runtime's new would reach our delete).
+#if defined(__SANITIZE_ADDRESS__)
+#define MARIONETTE_COUNT_ALLOCATIONS 0
+#else
+#define MARIONETTE_COUNT_ALLOCATIONS 1
+#endif
+namespace {
+std::size_t g_allocations = 0;
+}
+#if MARIONETTE_COUNT_ALLOCATIONS
+void* operator new(std::size_t n) {
+    ++g_allocations;
+    if (void* p = std::malloc(n ? n : 1)) return p;
+    throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#endif
 
 namespace {
 StickProgram one_second() { return parse_stick_program("ramp 500ms lx=1 ly=0.5\nhold 500ms\n", "t.prog"); }
@@ -261,4 +284,40 @@ TEST_CASE("in-process: a press shorter than a tick reaches the tick through the 
     // 0.5 is 192 on the wire (64/127 from centre); the deadzone rescales it.
     CHECK(last.left_x == Approx(32767.0 * (64.0 / 127.0 - 0.1) / 0.9).margin(2));
     CHECK(stats.count == 31);
+}
+
+TEST_CASE("hot path: read, parse, calibrate, quantise and push allocate nothing", "[firmware_sim][input]") {
+    const StickProgram p = parse_stick_program("circle 1s radius=1\npress south 10ms\n", "a.prog");
+    for (int f = 0; f < kHidFormatCount; ++f) {
+        const auto format = static_cast<HidFormat>(f);
+        INFO(hid_format_name(format));
+        fs::SimPadOptions o;
+        o.hid_format = format;
+        o.faults = fs::parse_faults("corrupt=0.05,noise=0.01");
+        fs::SimHidDevice device(fs::simulate_pad(p, o), format);
+        HidPad pad(device, format);
+        REQUIRE(pad.initialise(10));
+        FamilyCalibration cal;
+        cal.stick_deadzone = 0.1f;
+        cal.stick_curve = 1.7f;
+        static InputRing ring;
+        InputRingWriter<InputRing> writer(ring);
+        TimedInput drained;
+        InputSample s;
+        int samples = 0;
+        const std::size_t before = g_allocations;
+        for (;;) {
+            const HidPad::Result r = pad.read(s, 0);
+            if (r == HidPad::Result::nothing && device.finished()) break;
+            if (r != HidPad::Result::sample) continue;
+            apply_calibration(cal, false, s);
+            writer.push(to_timed_input(s));
+            ring.try_pop(drained);
+            ++samples;
+        }
+        if (MARIONETTE_COUNT_ALLOCATIONS) CHECK(g_allocations == before);
+        else WARN("allocations are not counted under AddressSanitizer");
+        CHECK(samples > 900);
+        CHECK(pad.counters().rejected() > 20);
+    }
 }

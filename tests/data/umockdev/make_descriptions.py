@@ -7,6 +7,12 @@ only from a record of exactly the requested size, so each variable-size query
 is written at the sizes libevdev (EVIOCGNAME/PHYS/UNIQ at 255 bytes, bitmaps at
 its array sizes) and SDL2 (EVIOCGNAME at 128) ask for.
 
+Buttons use the positional codes of the kernel's Documentation/input/gamepad.rst
+(BTN_WEST = the left face button), as hid-playstation sends them. The real xpad
+driver has long reported the Xbox X/Y buttons as BTN_X/BTN_Y, which are the
+codes of BTN_NORTH/BTN_WEST; SDL's mapping database corrects that for xpad's
+ids, so under SDL2 this Xbox description reads north as west.
+
 Usage: python3 make_descriptions.py [OUTPUT_DIR]   (default: this folder)
 """
 import os
