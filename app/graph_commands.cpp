@@ -18,6 +18,7 @@
 #include "app/graph_files.hpp"
 #include "app/json.hpp"
 #include "motion_graph/graph_builder.hpp"
+#include "render_es/image.hpp"
 #include "runtime/bvh.hpp"
 #include "runtime/graph_path.hpp"
 
@@ -72,7 +73,7 @@ std::string label_names(const MotionGraph& g, std::uint32_t mask) {
 void write_plot(const std::string& path, const graph::GraphBuildOutput& out) {
     const int size = out.plot_size;
     const std::int64_t n = out.frames;
-    std::vector<unsigned char> rgb(static_cast<size_t>(size) * static_cast<size_t>(size) * 3, 0);
+    std::vector<unsigned char> rgb(static_cast<size_t>(size) * static_cast<size_t>(size) * 3, 0);  // RGB, then RGBA
     // Brightness falls with distance (scaled by 8× the threshold): bright = similar.
     const double scale = std::max(out.threshold * 8.0, 1e-12);
     for (int x = 0; x < size; ++x)

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
-#include <set>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -59,59 +59,51 @@ std::vector<std::uint8_t> detect_foot_contacts(std::span<const vec3> positions, 
 
 namespace {
 
+struct PlacedTransition {
+    TransitionCandidate candidate;
+    PlanarTransform align;
+};
+
 // Nodes at every split point (clip ends, departures (A, i), arrivals (B, j+1)),
-// clip edges between consecutive split points, one transition edge per candidate.
-void assemble_graph(MotionGraph& g, const ClipDatabase& db, const std::vector<vec3>& positions,
-                    const FrameFeatures& features, const std::vector<TransitionCandidate>& candidates, int k,
-                    double leg) {
-    // Split points per clip: both ends, every departure (A, i) and every arrival (B, j+1).
-    const auto local = [&](std::int32_t global) {
-        const std::int32_t c = features.clip_of[static_cast<size_t>(global)];
-        return std::pair<std::int32_t, std::int32_t>(c, global - g.clips[static_cast<size_t>(c)].first_frame);
-    };
-    std::vector<std::set<std::int32_t>> splits(g.clips.size());
-    for (size_t c = 0; c < g.clips.size(); ++c) splits[c] = {0, g.clips[c].frame_count - 1};
-    std::vector<TransitionCandidate> usable;
-    for (const TransitionCandidate& t : candidates) {
-        const auto [ca, fa] = local(t.from_frame);
-        const auto [cb, fb] = local(t.to_frame);
-        if (fb + 1 >= g.clips[static_cast<size_t>(cb)].frame_count) continue;  // nothing to continue with after it
-        splits[static_cast<size_t>(ca)].insert(fa);
-        splits[static_cast<size_t>(cb)].insert(fb + 1);
-        usable.push_back(t);
+// keyed by global frame; clip edges between consecutive split points of a clip;
+// one transition edge per candidate.
+void assemble_graph(MotionGraph& g, const FrameFeatures& features, const std::vector<PlacedTransition>& transitions,
+                    int k) {
+    std::vector<std::int32_t> splits;
+    splits.reserve(2 * g.clips.size() + 2 * transitions.size());
+    for (const GraphClip& c : g.clips) splits.push_back(c.first_frame), splits.push_back(c.first_frame + c.frame_count - 1);
+    for (const PlacedTransition& t : transitions) {
+        splits.push_back(t.candidate.from_frame);
+        splits.push_back(t.candidate.to_frame + 1);
     }
-    std::map<std::pair<std::int32_t, std::int32_t>, std::int32_t> node_of;
-    for (size_t c = 0; c < g.clips.size(); ++c) {
-        std::int32_t previous = -1;
-        for (std::int32_t frame : splits[c]) {
-            const std::int32_t id = static_cast<std::int32_t>(g.nodes.size());
-            g.nodes.push_back({static_cast<std::int32_t>(c), frame});
-            node_of[{static_cast<std::int32_t>(c), frame}] = id;
-            if (previous >= 0) {
-                GraphEdge e;
-                e.from = previous;
-                e.to = id;
-                e.kind = GraphEdgeKind::clip;
-                e.frames = frame - g.nodes[static_cast<size_t>(previous)].frame;
-                g.edges.push_back(e);
-            }
-            previous = id;
+    std::sort(splits.begin(), splits.end());
+    splits.erase(std::unique(splits.begin(), splits.end()), splits.end());
+    const auto node_of = [&](std::int32_t global) {
+        return static_cast<std::int32_t>(std::lower_bound(splits.begin(), splits.end(), global) - splits.begin());
+    };
+    g.nodes.reserve(splits.size());
+    for (size_t n = 0; n < splits.size(); ++n) {
+        const std::int32_t clip = features.clip_of[static_cast<size_t>(splits[n])];
+        g.nodes.push_back({clip, splits[n] - g.clips[static_cast<size_t>(clip)].first_frame});
+        if (n > 0 && g.nodes[n - 1].clip == clip) {
+            GraphEdge e;
+            e.from = static_cast<std::int32_t>(n - 1);
+            e.to = static_cast<std::int32_t>(n);
+            e.kind = GraphEdgeKind::clip;
+            e.frames = splits[n] - splits[n - 1];
+            g.edges.push_back(e);
         }
     }
-    for (const TransitionCandidate& t : usable) {
-        const auto [ca, fa] = local(t.from_frame);
-        const auto [cb, fb] = local(t.to_frame);
-        PlanarTransform align;
-        reference_pair_distance(db, positions, k, leg, t.from_frame, t.to_frame, &align);
+    for (const PlacedTransition& t : transitions) {
         GraphEdge e;
-        e.from = node_of[{ca, fa}];
-        e.to = node_of[{cb, fb + 1}];
+        e.from = node_of(t.candidate.from_frame);
+        e.to = node_of(t.candidate.to_frame + 1);
         e.kind = GraphEdgeKind::transition;
         e.frames = k;
-        e.cost = t.distance;
-        e.align_angle = static_cast<float>(align.angle);
-        e.align_dx = static_cast<float>(align.dx);
-        e.align_dz = static_cast<float>(align.dz);
+        e.cost = t.candidate.distance;
+        e.align_angle = static_cast<float>(t.align.angle);
+        e.align_dx = static_cast<float>(t.align.dx);
+        e.align_dz = static_cast<float>(t.align.dz);
         g.edges.push_back(e);
     }
     index_edges(g);
@@ -175,19 +167,47 @@ GraphBuildOutput build_motion_graph(const ClipDatabase& db, const GraphBuildPara
     // Regular transitions below the threshold; then, while a clip is cut off
     // from the largest component, the cheapest bridge (a local minimum below the
     // looser bridge threshold) into and out of it, until it joins or none is left.
-    std::vector<TransitionCandidate> chosen, bridges;
-    for (const TransitionCandidate& t : out.candidates)
-        (t.distance <= out.threshold ? chosen : bridges).push_back(t);
+    // Usable candidates (something to continue with after the arrival), each placed
+    // once by the closed-form alignment of its windows, in parallel.
+    std::vector<PlacedTransition> placed;
+    for (const TransitionCandidate& t : out.candidates) {
+        const std::int32_t arrival = t.to_frame + 1;
+        if (arrival >= features.frames ||
+            features.clip_of[static_cast<size_t>(arrival)] != features.clip_of[static_cast<size_t>(t.to_frame)])
+            continue;
+        placed.push_back({t, {}});
+    }
+    {
+        const unsigned threads = std::max(1u, params.threads > 0 ? static_cast<unsigned>(params.threads)
+                                                                 : std::thread::hardware_concurrency());
+        std::vector<std::thread> workers;
+        for (unsigned w = 0; w < threads; ++w)
+            workers.emplace_back([&, w] {
+                for (size_t c = w; c < placed.size(); c += threads)
+                    reference_pair_distance(db, positions, k, leg, placed[c].candidate.from_frame,
+                                            placed[c].candidate.to_frame, &placed[c].align);
+            });
+        for (std::thread& t : workers) t.join();
+    }
+    std::vector<PlacedTransition> chosen, bridges;
+    for (const PlacedTransition& t : placed) (t.candidate.distance <= out.threshold ? chosen : bridges).push_back(t);
     out.regular_candidates = static_cast<std::int64_t>(chosen.size());
-    std::sort(bridges.begin(), bridges.end(), [](const TransitionCandidate& a, const TransitionCandidate& b) {
+    std::sort(bridges.begin(), bridges.end(), [](const PlacedTransition& x, const PlacedTransition& y) {
+        const TransitionCandidate &a = x.candidate, &b = y.candidate;
         return a.distance != b.distance ? a.distance < b.distance
                                         : (a.from_frame != b.from_frame ? a.from_frame < b.from_frame : a.to_frame < b.to_frame);
     });
     std::vector<bool> used(bridges.size(), false);
+    // Bridges by the clip they arrive in and the clip they leave.
+    std::vector<std::vector<size_t>> arriving(g.clips.size()), leaving(g.clips.size());
+    for (size_t b = 0; b < bridges.size(); ++b) {
+        arriving[static_cast<size_t>(features.clip_of[static_cast<size_t>(bridges[b].candidate.to_frame)])].push_back(b);
+        leaving[static_cast<size_t>(features.clip_of[static_cast<size_t>(bridges[b].candidate.from_frame)])].push_back(b);
+    }
     const MotionGraph base = g;
     for (int round = 0;; ++round) {
         g = base;
-        assemble_graph(g, db, positions, features, chosen, k, leg);
+        assemble_graph(g, features, chosen, k);
         out.prune = prune_to_largest_component(g);
         if (round >= 64) break;
         std::vector<bool> kept(g.clips.size(), false);
@@ -204,20 +224,15 @@ GraphBuildOutput build_motion_graph(const ClipDatabase& db, const GraphBuildPara
         for (size_t c = 0; c < g.clips.size(); ++c) {
             if (kept[c]) continue;
             // The cheapest pair: a bridge arriving in clip c no later than another leaves it.
-            const std::int32_t clip = static_cast<std::int32_t>(c);
             size_t best_in = bridges.size(), best_out = bridges.size();
             double best = std::numeric_limits<double>::infinity();
-            for (size_t bi = 0; bi < bridges.size(); ++bi) {
-                const TransitionCandidate& in = bridges[bi];
-                if (used[bi] || features.clip_of[static_cast<size_t>(in.to_frame)] != clip ||
-                    !on_kept[static_cast<size_t>(in.from_frame)])
-                    continue;
-                for (size_t bo = 0; bo < bridges.size(); ++bo) {
-                    const TransitionCandidate& leave = bridges[bo];
-                    if (used[bo] || features.clip_of[static_cast<size_t>(leave.from_frame)] != clip ||
-                        leave.to_frame + 1 >= features.frames || !on_kept[static_cast<size_t>(leave.to_frame + 1)] ||
-                        features.clip_of[static_cast<size_t>(leave.to_frame + 1)] !=
-                            features.clip_of[static_cast<size_t>(leave.to_frame)] ||
+            for (size_t bi : arriving[c]) {
+                const TransitionCandidate& in = bridges[bi].candidate;
+                if (used[bi] || !on_kept[static_cast<size_t>(in.from_frame)]) continue;
+                for (size_t bo : leaving[c]) {
+                    const TransitionCandidate& leave = bridges[bo].candidate;
+                    // Usable candidates arrive inside their clip (checked above), so to_frame + 1 exists.
+                    if (used[bo] || !on_kept[static_cast<size_t>(leave.to_frame + 1)] ||
                         leave.from_frame < in.to_frame + 1)
                         continue;
                     const double cost = static_cast<double>(in.distance) + leave.distance;

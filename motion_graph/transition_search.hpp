@@ -27,12 +27,15 @@ struct FrameFeatures {
     std::int32_t joints = 0;
     std::int32_t window = 10;            // k
     double weight = 0.0;                 // Σ w_j
-    std::vector<float> xz;               // [f][2J]: √w(x − cx)…, √w(z − cz)…
+    std::vector<float> xz;               // [f][2J]: √w(x − cx)…, √w(z − cz)… (c: frame centroid)
     std::vector<float> zx;               // [f][2J]: √w(z − cz)…, −√w(x − cx)…
     std::vector<float> y;                // [f][J]:  √w·y
     std::vector<double> cx, cz;          // weighted ground-plane centroid per frame
     std::vector<double> window_spread;   // per window start: Σ w|p − centroid|² over the window
     std::vector<double> window_cx, window_cz;  // per window start: Σ_t c over the window
+    // Per window start, 2k floats: √W·(c_t − window mean) as x…, z… (and z…, −x…),
+    // whose products give the centroid part of the alignment sums.
+    std::vector<float> window_dot, window_cross;
     std::vector<std::int32_t> clip_of;   // clip index of every frame
     std::vector<std::uint8_t> start_ok;  // the window starting here stays in one clip
     std::vector<std::uint8_t> end_ok;    // the window ending here stays in one clip
@@ -101,6 +104,6 @@ std::vector<std::pair<std::int32_t, std::int32_t>> local_minima(std::span<const 
 // Distance at a percentile (0–100) of all valid pairs: exact when there are at
 // most `max_samples` pairs, else over a deterministic sample of that many.
 std::vector<double> distance_percentiles(const FrameFeatures& features, const std::vector<double>& percentiles,
-                                         std::int64_t max_samples = 200000);
+                                         std::int64_t max_samples = 65536);
 
 }  // namespace marionette::graph

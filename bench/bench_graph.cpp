@@ -1,0 +1,202 @@
+// Motion-graph build and query costs (issue 4). Not a test: run by hand.
+//   build/release/bench/marionette_bench_graph
+// MARIONETTE_MOCAP_DIR (default ../shared/data/mocap) holds the CMU clips;
+// MARIONETTE_BENCH_FRAMES sets the synthetic database size (default 100000).
+// Reports, per build: seconds, pair evaluations per second, peak RSS; for the
+// reference comparison: both times, the speed-up and whether the candidates agree.
+#include <benchmark/benchmark.h>
+#include <sys/resource.h>
+
+#include <chrono>
+#include <ctime>
+#include <cstdlib>
+#include <random>
+
+#include "motion_graph/graph_builder.hpp"
+#include "runtime/graph_path.hpp"
+
+using namespace marionette;
+using namespace marionette::graph;
+
+namespace {
+
+std::string mocap_dir() {
+    const char* env = std::getenv("MARIONETTE_MOCAP_DIR");
+    return env && *env ? env : MARIONETTE_DEFAULT_MOCAP_DIR;
+}
+
+// CPU seconds of the whole process: with other work on the machine, wall time
+// over-states single-threaded costs; the speed-up ratio uses CPU time.
+double process_cpu_s() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+double peak_rss_mb() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
+
+LabelRules cmu_labels() {
+    LabelRules rules;
+    rules.origin = "bench";
+    rules.clip_patterns = {{"16_1*", {"walk"}}, {"16_33", {"walk", "stop"}}, {"16_35", {"run"}}, {"16_4*", {"run", "turn"}},
+                           {"16_57", {"run", "stop"}}};
+    return rules;
+}
+
+const ClipDatabase& cmu16() {
+    static const ClipDatabase db = [] {
+        std::vector<std::string> files;
+        for (const char* c : {"16_11", "16_15", "16_17", "16_19", "16_33", "16_35", "16_41", "16_43", "16_57"})
+            files.push_back(mocap_dir() + "/cmu_amc_16/" + c + ".amc");
+        return load_clip_database(files, mocap_dir() + "/cmu_amc_16/16.asf", cmu_labels(), 30.0);
+    }();
+    return db;
+}
+
+// The shared clips repeated until `frames`, each copy perturbed: every joint
+// rotation turned by up to ~2° about a random axis that drifts smoothly, and the
+// root moved and turned, so copies are similar but never identical.
+ClipDatabase synthetic(std::int64_t frames) {
+    const ClipDatabase& base = cmu16();
+    std::vector<Clip> clips;
+    std::mt19937 rng(1234);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    std::int64_t total = 0;
+    for (int copy = 0; total < frames; ++copy)
+        for (const Clip& source : base.clips) {
+            if (total >= frames) break;
+            Clip c = source;
+            c.name = source.name + "_" + std::to_string(copy);
+            const int J = c.joint_count();
+            std::vector<vec3> axis(static_cast<size_t>(J));
+            for (vec3& a : axis) a = glm::normalize(vec3(u(rng), u(rng), u(rng)) + vec3(0.01f));
+            const PlanarTransform place{u(rng) * 3.0, u(rng) * 100.0, u(rng) * 100.0};
+            for (int f = 0; f < c.frame_count; ++f)
+                for (int j = 0; j < J; ++j) {
+                    const size_t at = static_cast<size_t>(f) * static_cast<size_t>(J) + static_cast<size_t>(j);
+                    const double angle = 0.035 * std::sin(0.1 * f + j + copy);
+                    c.rotations[at] = quat_normalize(quat_mul(c.rotations[at], quat_axis_angle(axis[static_cast<size_t>(j)], angle)));
+                    if (j == 0) {
+                        c.rotations[at] = quat_mul(planar_rotation(place), c.rotations[at]);
+                        c.translations[at] = apply_planar(place, c.translations[at]);
+                    }
+                }
+            total += c.frame_count;
+            clips.push_back(std::move(c));
+        }
+    return make_clip_database(std::move(clips), {}, cmu_labels(), 30.0);
+}
+
+void report_build(benchmark::State& state, const GraphBuildOutput& out, double seconds) {
+    const double n = static_cast<double>(out.frames);
+    state.counters["frames"] = n;
+    state.counters["seconds"] = seconds;
+    state.counters["pair_evals_per_s"] = static_cast<double>(out.graph.stats.pair_evaluations) / seconds;
+    state.counters["candidates"] = static_cast<double>(out.regular_candidates);
+    state.counters["bridges"] = static_cast<double>(out.bridges);
+    state.counters["nodes_before"] = static_cast<double>(out.prune.nodes_before);
+    state.counters["nodes"] = static_cast<double>(out.prune.nodes);
+    state.counters["edges"] = static_cast<double>(out.prune.edges);
+    state.counters["kept_pct"] = 100.0 * static_cast<double>(out.graph.stats.frames_kept) / n;
+    state.counters["peak_rss_mb"] = peak_rss_mb();
+}
+
+void BM_BuildCmu16(benchmark::State& state) {
+    const ClipDatabase& db = cmu16();
+    for (auto _ : state) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const GraphBuildOutput out = build_motion_graph(db, GraphBuildParams{});
+        report_build(state, out, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    }
+}
+
+void BM_BuildSynthetic(benchmark::State& state) {
+    const char* env = std::getenv("MARIONETTE_BENCH_FRAMES");
+    const std::int64_t frames = env ? std::atoll(env) : 100000;
+    const ClipDatabase db = synthetic(frames);
+    for (auto _ : state) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const double c0 = process_cpu_s();
+        GraphBuildParams params;
+        params.bridge_percentile = params.threshold_percentile;  // no bridges: the copies connect by themselves
+        const GraphBuildOutput out = build_motion_graph(db, params);
+        report_build(state, out, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+        state.counters["cpu_s"] = process_cpu_s() - c0;
+    }
+}
+
+// The straightforward reference (per pair, per window frame, per joint) against
+// the tiled search on a subset, both on one thread.
+void BM_ReferenceSpeedup(benchmark::State& state) {
+    const ClipDatabase db = synthetic(static_cast<std::int64_t>(state.range(0)));
+    const double leg = skeleton_leg_length(db.skeleton, db.left_foot);
+    const std::vector<vec3> p = database_positions(db);
+    const FrameFeatures f = compute_frame_features(db, p, 10, leg);
+    CandidateSearchOptions o;
+    o.neighbourhood = 4;
+    o.threshold = distance_percentiles(f, {5.0})[0];
+    o.threads = 1;
+    for (auto _ : state) {
+        const double c0 = process_cpu_s();
+        const auto t0 = std::chrono::steady_clock::now();
+        const CandidateSearchResult tiled = find_transition_candidates(f, o);
+        const auto t1 = std::chrono::steady_clock::now();
+        const double c1 = process_cpu_s();
+        const CandidateSearchResult ref = find_transition_candidates_reference(db, p, f, leg, o);
+        const auto t2 = std::chrono::steady_clock::now();
+        const double c2 = process_cpu_s();
+        state.counters["tiled_cpu_s"] = c1 - c0;
+        state.counters["reference_cpu_s"] = c2 - c1;
+        state.counters["speedup_cpu"] = (c2 - c1) / (c1 - c0);
+        const double ts = std::chrono::duration<double>(t1 - t0).count(), rs = std::chrono::duration<double>(t2 - t1).count();
+        size_t same = 0;
+        for (size_t a = 0, b = 0; a < tiled.candidates.size() && b < ref.candidates.size();) {
+            const auto& x = tiled.candidates[a];
+            const auto& y = ref.candidates[b];
+            if (x.from_frame == y.from_frame && x.to_frame == y.to_frame) ++same, ++a, ++b;
+            else if (std::make_pair(x.from_frame, x.to_frame) < std::make_pair(y.from_frame, y.to_frame)) ++a;
+            else ++b;
+        }
+        state.counters["frames"] = static_cast<double>(f.frames);
+        state.counters["tiled_s"] = ts;
+        state.counters["reference_s"] = rs;
+        state.counters["speedup"] = rs / ts;
+        state.counters["tiled_candidates"] = static_cast<double>(tiled.candidates.size());
+        state.counters["reference_candidates"] = static_cast<double>(ref.candidates.size());
+        state.counters["same_candidates"] = static_cast<double>(same);
+    }
+}
+
+void BM_PathQuery(benchmark::State& state) {
+    static const GraphBuildOutput out = build_motion_graph(cmu16(), GraphBuildParams{});
+    const MotionGraph& g = out.graph;
+    GraphPathSearch search(g, 1.0);
+    std::mt19937 rng(5);
+    std::vector<double> micros;
+    for (auto _ : state) {
+        state.PauseTiming();
+        search.clear_goals();
+        search.add_label_goal(static_cast<int>(rng() % g.labels.size()));
+        const int start = static_cast<int>(rng() % g.nodes.size());
+        state.ResumeTiming();
+        const auto t0 = std::chrono::steady_clock::now();
+        benchmark::DoNotOptimize(search.run(start));
+        micros.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count());
+    }
+    std::sort(micros.begin(), micros.end());
+    state.counters["median_us"] = micros[micros.size() / 2];
+    state.counters["p99_us"] = micros[micros.size() * 99 / 100];
+    state.counters["max_us"] = micros.back();
+}
+
+}  // namespace
+
+BENCHMARK(BM_BuildCmu16)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_ReferenceSpeedup)->Arg(1000)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_PathQuery)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_BuildSynthetic)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_MAIN();
