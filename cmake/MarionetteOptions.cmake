@@ -4,9 +4,10 @@
 add_library(marionette_options INTERFACE)
 target_compile_options(marionette_options INTERFACE
   -Wall -Wextra -Wpedantic -Werror
-  # Determinism (DESIGN.md): never fast-math, never fuse a*b+c into an FMA,
+  # Determinism (DESIGN.md): never fuse a*b+c into an FMA (and never enable
+  # unsafe math: GCC's and Clang's defaults are IEEE-exact, so nothing to turn off),
   # so every build type and both compilers round identically.
-  -ffp-contract=off -fno-fast-math)
+  -ffp-contract=off)
 target_compile_definitions(marionette_options INTERFACE
   GLM_FORCE_RADIANS GLM_FORCE_CTOR_INIT GLM_FORCE_XYZW_ONLY)
 
