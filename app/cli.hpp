@@ -19,5 +19,8 @@ void register_run_command(CLI::App& app, int& exit_code);
 void register_log_commands(CLI::App& app, int& exit_code);   // record, replay
 void register_clip_commands(CLI::App& app, int& exit_code);  // clip info, clip fk
 void register_render_command(CLI::App& app, int& exit_code); // render (offline frames)
+void register_input_commands(CLI::App& app, int& exit_code);  // input list|monitor|decode, sim-pad
+void register_graph_commands(CLI::App& app, int& exit_code); // graph build, info, path
+void register_gait_eval_command(CLI::App& app, int& exit_code);  // gait-eval
 
 }  // namespace marionette

@@ -60,6 +60,33 @@ const KeySpec kKeys[] = {
     {"realtime", "simulation_cpu", &SimConfig::simulation_cpu, -1, 1023, "CPU the simulation thread is pinned to (-1: any)"},
     {"realtime", "render_cpu", &SimConfig::render_cpu, -1, 1023, "CPU the render thread is pinned to (-1: any)"},
     {"realtime", "lock_memory", &SimConfig::lock_memory, 0, 1, "1: lock all memory (mlockall) before the threads start"},
+    // motion graph (docs/motion-graph.md)
+    {"motion_graph", "analysis_rate_hz", &SimConfig::graph_analysis_rate_hz, 5, 240, "rate clips are resampled to for the graph build"},
+    {"motion_graph", "window_frames", &SimConfig::graph_window_frames, 2, 120, "k: frames in the distance window and in each transition"},
+    {"motion_graph", "neighbourhood_frames", &SimConfig::graph_neighbourhood_frames, 1, 60, "local minima are taken over (2h+1)² frame pairs"},
+    {"motion_graph", "threshold_percentile", &SimConfig::graph_threshold_percentile, 0.01, 100.0, "transition threshold as a percentile of all pair distances"},
+    {"motion_graph", "threshold_absolute", &SimConfig::graph_threshold_absolute, 0.0, 100.0, "when > 0, the threshold itself (mean squared distance in leg lengths²)"},
+    {"motion_graph", "bridge_percentile", &SimConfig::graph_bridge_percentile, 0.01, 100.0, "clips cut off from the component get their cheapest transitions below this percentile"},
+    {"motion_graph", "contact_height", &SimConfig::graph_contact_height, 0.0, 1.0, "foot contact: height above the clip's ground, leg lengths"},
+    {"motion_graph", "contact_speed", &SimConfig::graph_contact_speed, 0.0, 10.0, "foot contact: ground-plane speed, leg lengths per second"},
+    {"motion_graph", "transition_weight", &SimConfig::graph_transition_weight, 0.0, 1000.0, "path cost: seconds charged per unit of transition distance"},
+    // [gait] (docs/gait.md); the prototypes are [gait.walk] and [gait.run], below.
+    {"gait", "pelvis_height", &SimConfig::gait_pelvis_height, 0.3, 2.0, "hip height above the mean foot ground while stepping (m)"},
+    {"gait", "step_length_multiplier", &SimConfig::step_length_multiplier, 0.05, 2.0, "step length = multiplier · sqrt(speed)"},
+    {"gait", "min_step_duration", &SimConfig::min_step_duration, 0.1, 2.0, "shortest step (s)"},
+    {"gait", "max_step_duration", &SimConfig::max_step_duration, 0.1, 3.0, "longest step (s)"},
+    {"gait", "walk_duty", &SimConfig::walk_duty, 0.5, 0.9, "fraction of a cycle each foot is planted when walking"},
+    {"gait", "run_duty", &SimConfig::run_duty, 0.1, 0.49, "fraction of a cycle each foot is planted when running"},
+    {"gait", "run_threshold", &SimConfig::run_threshold, 0.1, 12.0, "speed above which the gait runs (m/s)"},
+    {"gait", "swing_clearance", &SimConfig::swing_clearance, 0.0, 0.3, "height the swing sole keeps above the ground (m)"},
+    {"gait", "spine_lean_deg_per_m_s", &SimConfig::spine_lean_deg_per_m_s, 0.0, 30.0, "forward spine lean per unit speed (°/(m/s))"},
+    {"gait", "max_spine_lean_deg", &SimConfig::max_spine_lean_deg, 0.0, 45.0, "largest spine lean (°)"},
+    {"gait", "interpolation_rate", &SimConfig::interpolation_rate, 0.1, 100.0, "how fast lean, walk/run blend and pelvis height follow their targets (1/s)"},
+    {"gait", "slope_speed_factor", &SimConfig::slope_speed_factor, 0.0, 0.05, "speed reduction per degree of slope"},
+    {"gait", "turn_in_place_deg", &SimConfig::turn_in_place_deg, 30.0, 180.0, "reversals wider than this turn in place (°)"},
+    {"gait", "stop_transition_s", &SimConfig::stop_transition_s, 0.05, 1.0, "longest time the swing foot takes to plant after a stop (s)"},
+    {"gait", "breath_amplitude", &SimConfig::breath_amplitude, 0.0, 0.05, "pelvis rise of a breath when idle (m)"},
+    {"gait", "breath_period_s", &SimConfig::breath_period_s, 0.5, 20.0, "length of one breath (s)"},
 };
 
 int line_of(const toml::node& node) { return static_cast<int>(node.source().begin.line); }
@@ -117,6 +144,57 @@ void apply_terrain_table(SimConfig& config, const toml::table& table, const std:
     config.terrain_name = name;
 }
 
+// [gait.walk] / [gait.run]: swing_foot, pelvis, hand, each an array of
+// [phase, x, y, z] keys (runtime/gait_prototype.hpp says what x, y, z mean).
+void apply_prototype_table(GaitPrototypes& out, const toml::node& node, const std::string& table, const std::string& file) {
+    const toml::table* t = node.as_table();
+    if (!t) throw ConfigError(file, line_of(node), table, "expected a table ([" + table + "]) of swing_foot, pelvis, hand");
+    for (const auto& [key, value] : *t) {
+        const std::string full = table + "." + std::string(key.str());
+        SplinePrototype* target = nullptr;
+        const bool open_path = key.str() == "swing_foot";
+        if (key.str() == "swing_foot") target = &out.swing_foot;
+        else if (key.str() == "pelvis") target = &out.pelvis;
+        else if (key.str() == "hand") target = &out.hand;
+        else throw ConfigError(file, line_of(value), full, "unknown key (expected one of: swing_foot, pelvis, hand)");
+        const toml::array* keys = value.as_array();
+        const std::string expected = "expected 2 to " + std::to_string(kMaxPrototypeKeys) + " keys [phase, x, y, z]";
+        if (!keys || keys->size() < 2 || keys->size() > static_cast<std::size_t>(kMaxPrototypeKeys))
+            throw ConfigError(file, line_of(value), full, expected);
+        SplinePrototype p;
+        for (const toml::node& k : *keys) {
+            const toml::array* numbers = k.as_array();
+            if (!numbers || numbers->size() != 4) throw ConfigError(file, line_of(k), full, expected);
+            float v[4];
+            for (std::size_t i = 0; i < 4; ++i) {
+                const toml::node& n = *numbers->get(i);
+                double d = 0.0;
+                if (const auto* f = n.as_floating_point()) d = f->get();
+                else if (const auto* in = n.as_integer()) d = static_cast<double>(in->get());
+                else throw ConfigError(file, line_of(k), full, expected + " (numbers)");
+                if (!std::isfinite(d) || std::fabs(d) > 10.0)
+                    throw ConfigError(file, line_of(k), full, "values must be finite and within ±10");
+                v[i] = static_cast<float>(d);
+            }
+            if (p.count > 0 && !(v[0] > p.keys[static_cast<std::size_t>(p.count - 1)].phase))
+                throw ConfigError(file, line_of(k), full, "phases must increase from key to key");
+            p.keys[static_cast<std::size_t>(p.count++)] = {v[0], v[1], v[2], v[3]};
+        }
+        const PrototypeKey& first = p.keys[0];
+        const PrototypeKey& last = p.keys[static_cast<std::size_t>(p.count - 1)];
+        if (first.phase != 0.0f || last.phase != 1.0f)
+            throw ConfigError(file, line_of(value), full, "the first key's phase must be 0 and the last key's 1");
+        if (open_path && !(first.x == 0.0f && first.y == 0.0f && first.z == 0.0f && last.x == 0.0f && last.y == 0.0f && last.z == 1.0f))
+            throw ConfigError(file, line_of(value), full,
+                              "a swing must start at [0, 0, 0, 0] and end at [1, 0, 0, 1] (on the planted positions)");
+        if (!open_path && !(first.x == last.x && first.y == last.y && first.z == last.z))
+            throw ConfigError(file, line_of(value), full, "a looping path must end with the values it starts with");
+        *target = p;
+    }
+}
+
+std::string serialize_prototypes(const GaitPrototypes& p, const std::string& table);
+
 std::string toml_string(const std::string& s) {
     std::string out = "\"";
     for (char ch : s) {
@@ -166,6 +244,10 @@ SimConfig apply_config_text(const SimConfig& base, std::string_view text, const 
         }
         for (const auto& [key, node] : *table) {
             const std::string full = table_name + "." + std::string(key.str());
+            if (table_name == "gait" && (key.str() == "walk" || key.str() == "run")) {
+                apply_prototype_table(key.str() == "walk" ? config.walk : config.run, node, full, file);
+                continue;
+            }
             const KeySpec* spec = nullptr;
             for (const KeySpec& k : kKeys)
                 if (table_name == k.table && key.str() == k.key) spec = &k;
@@ -193,6 +275,11 @@ SimConfig apply_config_text(const SimConfig& base, std::string_view text, const 
         }
     }
     // Relations between keys.
+    if (config.gait_pelvis_height >= config.thigh_length + config.shin_length + config.ankle_height)
+        throw ConfigError(file, doc["gait"]["pelvis_height"].node() ? line_of(*doc["gait"]["pelvis_height"].node()) : 0,
+                          "gait.pelvis_height", "must be less than thigh_length + shin_length + ankle_height, or the feet cannot reach");
+    if (config.min_step_duration > config.max_step_duration)
+        throw ConfigError(file, 0, "gait.min_step_duration", "must not exceed gait.max_step_duration");
     if (config.pelvis_height > config.thigh_length + config.shin_length + config.ankle_height + 1e-4f)
         throw ConfigError(file, doc["puppet"]["pelvis_height"].node() ? line_of(*doc["puppet"]["pelvis_height"].node()) : 0,
                           "puppet.pelvis_height",
@@ -226,11 +313,30 @@ std::string serialize_config(const SimConfig& config) {
             out += format_number(config.*std::get<FloatField>(k.field));
         out += "\n";
     }
+    out += serialize_prototypes(config.walk, "gait.walk");
+    out += serialize_prototypes(config.run, "gait.run");
     // The terrain, resolved and inline: the text alone determines the ground.
     out += "\n[terrain]\nname = " + toml_string(config.terrain_name) + "\n";
     out += serialize_terrain(config.terrain, "terrain.");
     return out;
 }
+
+namespace {
+std::string serialize_prototypes(const GaitPrototypes& p, const std::string& table) {
+    std::string out = "\n[" + table + "]   # keys [phase, x, y, z] (docs/gait.md)\n";
+    const std::pair<const char*, const SplinePrototype*> paths[] = {{"swing_foot", &p.swing_foot}, {"pelvis", &p.pelvis}, {"hand", &p.hand}};
+    for (const auto& [name, proto] : paths) {
+        out += std::string(name) + " = [";
+        for (int i = 0; i < proto->count; ++i) {
+            const PrototypeKey& k = proto->keys[static_cast<std::size_t>(i)];
+            out += std::string(i ? ", " : "") + "[" + format_number(k.phase) + ", " + format_number(k.x) + ", " + format_number(k.y) +
+                   ", " + format_number(k.z) + "]";
+        }
+        out += "]\n";
+    }
+    return out;
+}
+}  // namespace
 
 SimConfig config_from_text(std::string_view text, const std::string& origin) {
     return apply_config_text(default_config(), text, origin);

@@ -15,6 +15,9 @@ int main(int argc, char** argv) {
     register_log_commands(app, exit_code);
     register_clip_commands(app, exit_code);
     register_render_command(app, exit_code);
+    register_input_commands(app, exit_code);
+    register_graph_commands(app, exit_code);
+    register_gait_eval_command(app, exit_code);
 
     try {
         app.parse(argc, argv);

@@ -1,7 +1,5 @@
 #include "app/pipeline.hpp"
 
-#include "app/live_view.hpp"
-
 #include <fmt/format.h>
 #include <poll.h>
 #include <pthread.h>
@@ -17,6 +15,8 @@
 #include "app/files.hpp"
 #include "app/realtime.hpp"
 #include "app/replay.hpp"
+#include "render_es/interpolate.hpp"
+#include "render_es/view.hpp"
 #include "runtime/det_math.hpp"
 #include "runtime/fixed_step.hpp"
 
@@ -28,15 +28,16 @@ SimulationLoop::SimulationLoop(const SimConfig& config, PipelineShared& shared,
                                std::vector<ScheduledConfigChange> scheduled, bool wait_when_full)
     : sim_(config), shared_(shared), scheduled_(std::move(scheduled)), wait_when_full_(wait_when_full) {}
 
-void SimulationLoop::apply(const SimConfig& config) {
+void SimulationLoop::apply(const SimConfig& config, TickRecord::ConfigSource source, std::uint32_t id) {
     // The watcher refused structural changes already, and a log's changes were
-    // checked when it was decoded, so retune cannot fail here.
+    // checked when it was decoded, so retune cannot fail here. It copies the
+    // configuration into the simulation's; the terrain is structural, so its
+    // arrays have the same sizes and the copy reuses their storage.
     if (!sim_.retune(config).empty()) return;
-    const auto slot = static_cast<std::uint32_t>(config_changes_ % PipelineShared::kAppliedConfigSlots);
     ++config_changes_;
-    shared_.applied_configs[slot] = config;  // a live edit may allocate here: not the steady state
     record_.kind = TickRecord::Kind::config_change;
-    record_.config_slot = slot;
+    record_.config_source = source;
+    record_.config_id = id;
     push(record_);
 }
 
@@ -54,9 +55,14 @@ void SimulationLoop::push(const TickRecord& record) {
 void SimulationLoop::run_tick(std::int64_t tick_time_ns, std::int64_t now_ns) {
     // Tick boundary: configuration changes first, so the log can place them.
     const std::uint64_t k = sim_.state().tick;
-    while (next_scheduled_ < scheduled_.size() && scheduled_[next_scheduled_].before_tick <= k)
-        apply(scheduled_[next_scheduled_++].config);
-    if (shared_.config_updates.take()) apply(shared_.config_updates.front().config);
+    while (next_scheduled_ < scheduled_.size() && scheduled_[next_scheduled_].before_tick <= k) {
+        apply(scheduled_[next_scheduled_].config, TickRecord::ConfigSource::recorded,
+              static_cast<std::uint32_t>(next_scheduled_));
+        ++next_scheduled_;
+    }
+    if (shared_.config_updates.take())
+        apply(shared_.config_updates.front().config, TickRecord::ConfigSource::live_edit,
+              shared_.config_updates.front().version);
 
     // The oldest sample due has waited longest: it is this tick's worst latency.
     if (const TimedInput* oldest = shared_.input_ring.peek(); oldest && oldest->timestamp_ns <= tick_time_ns)
@@ -73,6 +79,7 @@ void SimulationLoop::run_tick(std::int64_t tick_time_ns, std::int64_t now_ns) {
     const PuppetState& now = sim_.state();
     frame.current = now;
     frame.current_time_ns = tick_time_ns;
+    frame.connected = assembler_.connected();
     frame.tick_ns = 1'000'000'000 / sim_.config().tick_rate_hz;
     shared_.states.publish();
 
@@ -185,6 +192,7 @@ void input_thread(PipelineShared& sh, const InputScript& script, std::int64_t t0
         if (script.stamp_when_read) sample.timestamp_ns = monotonic_ns();
         if (sample.connected) writer.push(sample);
         else writer.push_disconnect(sample.timestamp_ns);
+        if (!script.stamp_when_read) sh.input_watermark_ns.store(t0 + event.timestamp_ns, std::memory_order_release);
         sh.counters.samples_pushed.store(writer.pushed(), std::memory_order_relaxed);
         sh.counters.samples_dropped.store(writer.dropped(), std::memory_order_relaxed);
     }
@@ -199,8 +207,11 @@ struct SimulationThreadResult {
     std::uint64_t catch_up_drops = 0;
 };
 
+// `wait_for_input`: every sample up to a tick's time must be in the ring before
+// the tick runs (virtual time, and recordings replayed live, which stay exact
+// even when the input thread is descheduled for a moment).
 void simulation_thread(PipelineShared& sh, SimulationLoop& loop, std::uint64_t total_ticks, std::int64_t t0,
-                       bool virtual_time, SimulationThreadResult& result) {
+                       bool virtual_time, bool wait_for_input, SimulationThreadResult& result) {
     set_simulation_float_mode();
     const SimConfig& config = loop.simulation().config();
     FixedStepDriver driver = FixedStepDriver::at_rate(config.tick_rate_hz, config.max_catch_up_ticks);
@@ -242,29 +253,93 @@ void simulation_thread(PipelineShared& sh, SimulationLoop& loop, std::uint64_t t
             sim_time += driver.dropped_ns - dropped_before;
             sh.counters.catch_up_drops.store(driver.catch_up_cap_hits, std::memory_order_relaxed);
         }
-        for (std::int32_t i = 0; i < due && ticks < total_ticks; ++i) run_one(monotonic_ns());
+        for (std::int32_t i = 0; i < due && ticks < total_ticks; ++i) {
+            while (wait_for_input && sh.input_watermark_ns.load(std::memory_order_acquire) < sim_time + tick_ns &&
+                   !sh.input_done.load(std::memory_order_acquire) && !sh.stop.load(std::memory_order_relaxed))
+                sleep_until_ns(monotonic_ns() + 100'000);  // a sleep, not a spin: the input thread may share our CPU
+            run_one(monotonic_ns());
+        }
     }
     result.catch_up_drops = driver.catch_up_cap_hits;
     sh.simulation_done.store(true, std::memory_order_release);
 }
 
-void render_thread(PipelineShared& sh, int frame_rate_hz, std::int64_t t0, bool virtual_time,
-                   FrameTimeHistogram& frame_time, LiveView* display) {
+// The GL display, when there is one: made on the render thread (its EGL context
+// is current there), which reports how that went before the run starts.
+struct DisplayThreadState {
+    enum : int { opening, ready, failed };
+    std::atomic<int> state{opening};
+    std::string error;        // failed: why (written before `state`)
+    std::string description;  // ready: the platform
+    std::atomic<bool> closed{false};
+};
+
+struct RenderInputs {
+    const DisplayOptions* display = nullptr;
+    const Skeleton* skeleton = nullptr;
+    const Terrain* terrain = nullptr;
+    float ankle_height = 0.08f;
+    int tick_rate_hz = 240;
+};
+
+void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, RenderInputs in,
+                   DisplayThreadState& display, FrameTimeHistogram& frame_time) {
     FrameLoop frames(sh);
+    std::unique_ptr<render::View> view;
+    if (in.display->gl) {
+        try {
+            view = std::make_unique<render::View>(in.display->platform, in.display->settings, *in.skeleton, *in.terrain);
+            display.description = view->platform().description();
+            display.state.store(DisplayThreadState::ready, std::memory_order_release);
+        } catch (const std::exception& e) {
+            display.error = e.what();
+            display.state.store(DisplayThreadState::failed, std::memory_order_release);
+            return;
+        }
+    } else {
+        display.state.store(DisplayThreadState::ready, std::memory_order_release);
+    }
+    // Everything a GL frame needs, made once.
+    PuppetState drawn{};
+    render::DebugOverlay overlay{};
+    std::array<char, 256> hud{};
+    const bool paced_by_display = view && view->platform().kind() != render::PlatformKind::headless &&
+                                  in.display->platform.vsync;
     const std::int64_t period = 1'000'000'000 / frame_rate_hz;
-    std::int64_t deadline = t0 + period;
+    std::int64_t deadline = monotonic_ns() + period;
     std::int64_t window_max = 0;
     std::uint64_t count = 0;
     std::uint64_t missed = 0;
     volatile float sink = 0.0f;  // keeps the headless frame's work from being optimised away
     while (!sh.stop.load(std::memory_order_relaxed) && !sh.simulation_done.load(std::memory_order_acquire)) {
-        if (!sleep_until_ns_or_stop(virtual_time ? monotonic_ns() + 1'000'000 : deadline, sh.stop)) break;
+        // A window or KMS presents on vblank, which paces us; else our own deadline does.
+        if (!(paced_by_display && frames.has_state()) &&
+            !sleep_until_ns_or_stop(virtual_time ? monotonic_ns() + 1'000'000 : deadline, sh.stop))
+            break;
         const std::int64_t start = monotonic_ns();
         const std::int64_t at = virtual_time ? sh.states.front().current_time_ns : start;
         sink = sink + frames.run_frame(at).x;
-        if (display != nullptr && frames.has_state()) {
-            const StateFrame& f = sh.states.front();
-            display->frame(f.previous, f.current, static_cast<float>(frames.alpha()));
+        if (view && frames.has_state()) {
+            const StateFrame& pair = frames.state_pair();
+            render::interpolate_state(pair.previous, pair.current, static_cast<float>(frames.alpha()), drawn);
+            render::feet_overlay_from_state(drawn, *in.terrain, in.ankle_height, overlay);
+            const PipelineCounters& c = sh.counters;
+            const float speed = std::sqrt(drawn.velocity.x * drawn.velocity.x + drawn.velocity.y * drawn.velocity.y);
+            // The stats overlay, formatted into fixed space (no allocation in the frame).
+            const auto n = fmt::format_to_n(
+                hud.data(), hud.size() - 1,
+                "t {:.1f} s  {:.2f} m/s{}  tick max {:.0f} us  input->tick max {:.1f} ms  dropped {}  missed frames {}",
+                static_cast<double>(drawn.tick) / in.tick_rate_hz, speed,
+                frames.state_pair().connected ? "" : "  [no controller: idling]",
+                c.tick_time_max_ns.load(std::memory_order_relaxed) / 1e3,
+                c.input_latency_max_ns.load(std::memory_order_relaxed) / 1e6,
+                c.samples_dropped.load(std::memory_order_relaxed), c.missed_frames.load(std::memory_order_relaxed));
+            const render::FrameResult r = view->frame(drawn, overlay, std::string_view(hud.data(), n.size),
+                                                      static_cast<float>(period) / 1e9f);
+            if (r.events.close_requested) {
+                display.closed.store(true, std::memory_order_release);
+                break;
+            }
         }
         const std::int64_t end = monotonic_ns();
         frame_time.add(end - start);
@@ -283,7 +358,6 @@ void render_thread(PipelineShared& sh, int frame_rate_hz, std::int64_t t0, bool 
             sh.counters.missed_frames.store(missed, std::memory_order_relaxed);
         }
     }
-    if (display != nullptr) display->release_thread();
 }
 
 const char* activity(float speed) {
@@ -335,6 +409,9 @@ struct LiveTuning {
     std::unique_ptr<ConfigWatcher> watcher;
     SimConfig published;       // the newest configuration handed over
     std::uint32_t version = 0;
+    // Every configuration handed over, by version − 1: the simulation names the
+    // one it applied and the writer logs it (edits come at human pace).
+    std::vector<SimConfig> history;
     std::int64_t dirty_since = -1;
 
     void reload(PipelineShared& sh, std::FILE* err) {
@@ -354,6 +431,7 @@ struct LiveTuning {
         }
         if (serialize_config(next) == serialize_config(published)) return;
         published = next;
+        history.push_back(next);
         ConfigUpdate& update = sh.config_updates.back();
         update.version = ++version;
         update.config = next;
@@ -415,25 +493,40 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
     sigaddset(&stop_signals, SIGTERM);
     pthread_sigmask(SIG_BLOCK, &stop_signals, &previous_mask);
 
-    const std::int64_t wall_start = monotonic_ns();
-    const std::int64_t t0 = o.virtual_time ? 0 : wall_start + 20'000'000;  // let the threads start first
     SimulationThreadResult sim_result;
+    DisplayThreadState display;
+    RenderInputs render_inputs{&o.display, &loop->simulation().skeleton(), &loop->simulation().terrain(),
+                               config.ankle_height, config.tick_rate_hz};
     std::thread sim_thread, in_thread, gfx_thread;
     ThreadGuard guard{{&sim_thread, &in_thread, &gfx_thread}, sh};
+    std::int64_t wall_start = 0;
     try {
+        // The render thread first: the display must open before the clock starts.
+        gfx_thread = std::thread(render_thread, std::ref(sh), o.frame_rate_hz, o.virtual_time, render_inputs,
+                                 std::ref(display), std::ref(result.frame_time));
+        while (display.state.load(std::memory_order_acquire) == DisplayThreadState::opening)
+            sleep_until_ns(monotonic_ns() + 1'000'000);
+        if (display.state.load(std::memory_order_acquire) == DisplayThreadState::failed) {
+            gfx_thread.join();
+            throw render::PlatformError(display.error);
+        }
+        result.display_description = display.description;
+        wall_start = monotonic_ns();
+        const std::int64_t t0 = o.virtual_time ? 0 : wall_start + 20'000'000;  // let the threads start first
         sim_thread = std::thread(simulation_thread, std::ref(sh), std::ref(*loop), o.total_ticks, t0, o.virtual_time,
-                                 std::ref(sim_result));
+                                 !o.script.stamp_when_read, std::ref(sim_result));
         in_thread = std::thread(input_thread, std::ref(sh), std::cref(o.script), t0, o.virtual_time);
-        gfx_thread = std::thread(render_thread, std::ref(sh), o.frame_rate_hz, t0, o.virtual_time,
-                                 std::ref(result.frame_time), o.display);
     } catch (...) {
         pthread_sigmask(SIG_SETMASK, &previous_mask, nullptr);
         throw;
     }
     pthread_sigmask(SIG_SETMASK, &previous_mask, nullptr);
-    note_failure(apply_thread_settings(in_thread, "mario-input", config.input_priority, config.input_cpu));
-    note_failure(apply_thread_settings(sim_thread, "mario-sim", config.simulation_priority, config.simulation_cpu));
-    note_failure(apply_thread_settings(gfx_thread, "mario-render", config.render_priority, config.render_cpu));
+    // Virtual time waits by spinning: never under SCHED_FIFO, where a spinning
+    // thread would starve the writer it waits for.
+    const bool fifo = !o.virtual_time;
+    note_failure(apply_thread_settings(in_thread, "mario-input", fifo ? config.input_priority : 0, config.input_cpu));
+    note_failure(apply_thread_settings(sim_thread, "mario-sim", fifo ? config.simulation_priority : 0, config.simulation_cpu));
+    note_failure(apply_thread_settings(gfx_thread, "mario-render", fifo ? config.render_priority : 0, config.render_cpu));
     if (!realtime_failed.empty()) {
         result.realtime_warning = realtime_failed;
         fmt::print(o.err, "warning: real-time settings not permitted ({}); running with normal scheduling\n",
@@ -453,7 +546,9 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
     auto handle = [&](const TickRecord& r) {
         const double seconds = static_cast<double>(r.tick) / config.tick_rate_hz;
         if (r.kind == TickRecord::Kind::config_change) {
-            const SimConfig& applied = sh.applied_configs[r.config_slot];
+            const SimConfig& applied = r.config_source == TickRecord::ConfigSource::recorded
+                                           ? o.scheduled_changes.at(r.config_id).config
+                                           : tuning.history.at(r.config_id - 1);
             if (log) log->append_config_change(serialize_config(applied));
             fmt::print(o.out, "[{:6.1f} s] config: applied before tick {}: {}\n", seconds, r.tick,
                        config_diff(logged_config, applied));
@@ -461,7 +556,13 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
             return;
         }
         result.ticks = r.tick;
-        if (log) log->append_tick(r.input);
+        if (log) {
+            log->append_tick(r.input);
+            if (log->pending_ticks() >= flush_ticks) {
+                log->flush();  // a chunk per 250 ms of ticks: kill -9 loses at most that
+                last_flush = monotonic_ns();
+            }
+        }
         const vec3 root(r.root_position[0], r.root_position[1], r.root_position[2]);
         if (trace && std::fputs(trace_csv_row(r.tick, r.hash, root).c_str(), trace.get()) < 0)
             throw std::runtime_error(o.trace_file + ": write failed");
@@ -480,11 +581,13 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
             const PipelineCounters& c = sh.counters;
             fmt::print(o.out,
                        "[{:6.1f} s] {:<8} {:4.2f} m/s  heading {:4.0f}°  at ({:6.2f}, {:6.2f})  walked {:5.1f} m | "
-                       "tick max {:.0f} µs  input→tick max {:.1f} ms  frames {} (missed {})  dropped {}{}\n",
+                       "tick max {:.0f} µs  input→tick max {:.1f} ms  frame max {:.0f} µs  frames {} (missed {})  "
+                       "dropped {}{}\n",
                        seconds, connected ? activity(speed) : "idle", speed, r.heading * det::kRadToDeg,
                        root.x, root.z, result.distance_m,
                        c.tick_time_max_ns.load(std::memory_order_relaxed) / 1e3,
                        c.input_latency_max_ns.load(std::memory_order_relaxed) / 1e6,
+                       c.frame_time_max_ns.load(std::memory_order_relaxed) / 1e3,
                        c.frames.load(std::memory_order_relaxed), c.missed_frames.load(std::memory_order_relaxed),
                        c.samples_dropped.load(std::memory_order_relaxed), connected ? "" : "  [no controller]");
             std::fflush(o.out);
@@ -495,14 +598,20 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
         const bool finished = sh.simulation_done.load(std::memory_order_acquire);
         while (sh.records.try_pop(record)) handle(record);
         const std::int64_t now = monotonic_ns();
-        if (log && log->pending_ticks() > 0 && (log->pending_ticks() >= flush_ticks || now - last_flush >= 200'000'000)) {
-            log->flush();  // a chunk at least every 250 ms: kill -9 loses at most that
+        // And by the clock, should ticks come slowly; virtual time flushes by tick
+        // count only, so its logs are byte-for-byte repeatable.
+        if (log && !o.virtual_time && log->pending_ticks() > 0 && now - last_flush >= 200'000'000) {
+            log->flush();
             last_flush = now;
         }
         if (finished) break;  // simulation_done was read before the last drain
         if (stop_seen < 0 && o.stop_request && o.stop_request->load()) {
             stop_seen = now;
             result.stopped = true;
+            sh.stop.store(true);
+        }
+        if (!result.display_closed && display.closed.load(std::memory_order_acquire)) {
+            result.display_closed = true;  // closing the window ends the run normally
             sh.stop.store(true);
         }
         if (tuning.watcher) {

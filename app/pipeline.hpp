@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "render_es/platform.hpp"
+#include "render_es/settings.hpp"
 #include "runtime/input_log.hpp"
 #include "runtime/latency_histogram.hpp"
 #include "runtime/latest_value.hpp"
@@ -39,6 +41,7 @@ struct StateFrame {
     PuppetState current;
     std::int64_t current_time_ns = 0;  // when `current`'s tick was due
     std::int64_t tick_ns = 0;
+    bool connected = true;             // the controller, for the on-screen notice
 };
 
 // Simulation → writer, per tick (and per configuration change, in order).
@@ -53,9 +56,12 @@ struct TickRecord {
     std::array<float, 3> root_position{};
     std::array<float, 2> velocity{};
     float heading = 0.0f;
-    // config_change: the configuration now in force is PipelineShared::applied_configs[config_slot].
-    // (SimConfig holds the terrain's arrays, so it cannot ride in the ring itself.)
-    std::uint32_t config_slot = 0;
+    // config_change: which configuration is now in force. The configuration itself
+    // (it owns the terrain's arrays) stays with the writer, who made or read it:
+    // a live edit by its version, a recorded change by its index.
+    enum class ConfigSource : std::uint8_t { live_edit, recorded };
+    ConfigSource config_source = ConfigSource::live_edit;
+    std::uint32_t config_id = 0;
 };
 using RecordRing = SpscRing<TickRecord, kRecordRingCapacity>;
 
@@ -91,13 +97,6 @@ struct PipelineShared {
     RecordRing records;
     LatestValue<StateFrame> states;
     LatestValue<ConfigUpdate> config_updates;
-    // Configurations the simulation applied, by change count % kAppliedConfigSlots:
-    // written by the simulation thread before it pushes the config_change record,
-    // read by the writer after popping it. A slot is reused only after
-    // kAppliedConfigSlots further changes, far more than edits arrive in the
-    // writer's few milliseconds of lag.
-    static constexpr std::uint32_t kAppliedConfigSlots = 16;
-    std::array<SimConfig, kAppliedConfigSlots> applied_configs{};
     // Virtual time only: the newest timestamp the input thread has pushed.
     std::atomic<std::int64_t> input_watermark_ns{INT64_MIN};
     std::atomic<bool> input_done{false};
@@ -123,7 +122,7 @@ public:
     std::uint64_t config_changes() const { return config_changes_; }
 
 private:
-    void apply(const SimConfig& config);
+    void apply(const SimConfig& config, TickRecord::ConfigSource source, std::uint32_t id);
     void push(const TickRecord& record);
 
     Simulation sim_;
@@ -149,6 +148,8 @@ public:
     vec3 run_frame(std::int64_t frame_time_ns);
     bool has_state() const { return has_state_; }
     double alpha() const { return alpha_; }
+    // The state pair the last run_frame() interpolated (valid once has_state()).
+    const StateFrame& state_pair() const { return shared_.states.front(); }
     const std::array<vec3, kMaxJoints>& joints() const { return joints_; }
 
 private:
@@ -185,7 +186,14 @@ InputScript script_from_log(const DecodedInputLog& log, std::int64_t tick_ns);
 using TickTimeHistogram = DurationHistogram<1'000, 2048>;     // 1 µs buckets, ≤ 2 ms
 using FrameTimeHistogram = DurationHistogram<1'000, 4096>;    // 1 µs buckets, ≤ 4 ms
 
-class LiveView;  // app/live_view.hpp
+// What the render thread draws on. Without `gl` it runs the headless frame loop
+// (interpolation only, no GPU); with it, render_es draws every frame in a
+// window or on KMS (render_es/view.hpp), presenting paced by the display.
+struct DisplayOptions {
+    bool gl = false;
+    render::PlatformOptions platform;
+    render::RenderSettings settings;
+};
 
 struct PipelineOptions {
     SimConfig config;
@@ -196,9 +204,7 @@ struct PipelineOptions {
     // waiting for every sample up to its time, so the run is deterministic.
     bool virtual_time = false;
     int frame_rate_hz = 60;            // the headless frame loop's pace
-    // Render (issue 7): a window or KMS display the render thread draws each frame
-    // on (opened by the caller, its context released); nullptr: headless frames.
-    LiveView* display = nullptr;
+    DisplayOptions display;
     std::string record_file;           // input log ("" = none)
     std::string trace_file;            // per-tick CSV ("" = none)
     std::string watch_config_file;     // live tuning ("" = none)
@@ -232,10 +238,13 @@ struct PipelineResult {
     std::uint64_t disconnects = 0;
     std::uint64_t reconnects = 0;
     std::string realtime_warning;       // what the [realtime] settings could not do
+    bool display_closed = false;        // the window was closed (ends the run)
+    std::string display_description;    // the GL platform, when one was used
 };
 
-// Runs the whole pipeline until total_ticks have run or a stop is requested.
-// Throws std::runtime_error when an output cannot be created or written.
+// Runs the whole pipeline until total_ticks have run, a stop is requested or the
+// window is closed. Throws std::runtime_error when an output cannot be created
+// or written, render::PlatformError when the display cannot be opened.
 PipelineResult run_pipeline(const PipelineOptions& options);
 
 }  // namespace marionette

@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <csignal>
+#include <limits>
 #include <memory>
 
 #include "app/cli.hpp"
@@ -13,9 +14,9 @@
 #include "app/config.hpp"
 #include "app/files.hpp"
 #include "app/json.hpp"
-#include "app/live_view.hpp"
 #include "app/pipeline.hpp"
 #include "app/program_source.hpp"
+#include "app/render_config.hpp"
 #include "app/replay.hpp"
 
 namespace marionette {
@@ -43,13 +44,14 @@ std::string histogram_json(const Histogram& h) {
 
 void write_stats_json(const std::string& path, const RunOptions& o, const SimConfig& config, const PipelineResult& r) {
     const std::string text = fmt::format(
-        "{{\"input\":{},\"display\":\"headless\",\"tick_rate_hz\":{},\"ticks\":{},\"duration_s\":{},\"wall_s\":{},"
+        "{{\"input\":{},\"display\":{},\"tick_rate_hz\":{},\"ticks\":{},\"duration_s\":{},\"wall_s\":{},"
         "\"stopped\":{},\"shutdown_ms\":{},\"final_hash\":\"{:016x}\","
         "\"tick_time_us\":{},\"frame_time_us\":{},\"input_to_tick_latency_us\":{},"
         "\"samples\":{},\"dropped_samples\":{},\"frames\":{},\"missed_frames\":{},\"catch_up_drops\":{},"
         "\"records_dropped\":{},\"config_changes\":{},\"disconnects\":{},\"reconnects\":{},"
         "\"distance_m\":{},\"top_speed_m_s\":{},\"realtime_warning\":{}}}\n",
-        json::quote(o.input), config.tick_rate_hz, r.ticks, json::number(static_cast<double>(r.ticks) / config.tick_rate_hz),
+        json::quote(o.input), json::quote(r.display_description.empty() ? "headless" : r.display_description),
+        config.tick_rate_hz, r.ticks, json::number(static_cast<double>(r.ticks) / config.tick_rate_hz),
         json::number(r.wall_s), r.stopped ? "true" : "false", json::number(r.shutdown_ms), r.final_hash,
         histogram_json(r.tick_time), histogram_json(r.frame_time), histogram_json(r.input_latency), r.samples_pushed,
         r.samples_dropped, r.frames, r.missed_frames, r.catch_up_drops, r.records_dropped, r.config_changes,
@@ -112,6 +114,29 @@ int run_command(const RunOptions& o) {
     } else {
         throw ImportError("--input " + input, 0, "expected auto, evdev, hidapi, sdl, sim:PROGRAM or log:FILE");
     }
+    const std::uint64_t headless_ticks = p.total_ticks;
+    // The display: a window or KMS draws with render_es; headless (also what auto
+    // picks with no display) runs the interpolating frame loop without a GPU.
+    const render::PlatformRequest request = o.display == "window" ? render::PlatformRequest::window
+                                            : o.display == "kms"  ? render::PlatformRequest::kms
+                                            : o.display == "headless" ? render::PlatformRequest::headless
+                                                                      : render::PlatformRequest::automatic;
+    const render::PlatformKind kind = render::select_platform(request, render::detect_display_environment());
+    if (kind != render::PlatformKind::headless) {
+        const RenderConfig rc = load_render_config("");
+        p.display.gl = true;
+        p.display.settings = rc.settings;
+        p.display.platform.kind = kind;
+        p.display.platform.width = rc.settings.width;
+        p.display.platform.height = rc.settings.height;
+        p.display.platform.msaa_samples = rc.settings.msaa_samples;
+        p.display.platform.vsync = rc.settings.vsync;
+        p.display.platform.fullscreen = rc.settings.fullscreen;
+        p.display.platform.drm_device = rc.drm_device;
+        p.display.platform.kms_mode = rc.kms;
+        // With a display the run lasts until the window is closed (or --duration).
+        p.total_ticks = std::numeric_limits<std::uint64_t>::max();
+    }
     if (o.duration_s >= 0.0) p.total_ticks = static_cast<std::uint64_t>(o.duration_s * config.tick_rate_hz + 0.5);
 
     p.config = config;
@@ -121,14 +146,14 @@ int run_command(const RunOptions& o) {
     p.watch_config_file = o.config_file;  // live tuning of the file given
     p.stop_request = &g_stop_requested;
     p.stop_request_time_ns = &g_stop_requested_ns;
-    // A window or KMS display when --display (or auto) picks one; nullptr: console only.
-    g_stop_requested.store(false);
-    const std::unique_ptr<LiveView> live = LiveView::open(o.display, o.render_config_file, config, &g_stop_requested);
-    p.display = live.get();
-    if (live) fmt::print("display: {}\n", live->description());
 
-    fmt::print("marionette: {}, {} at {} Hz for {:.1f} s{}\n", live ? "run" : "headless run", source, config.tick_rate_hz,
-               static_cast<double>(p.total_ticks) / config.tick_rate_hz, o.fast ? " (no real-time pacing)" : "");
+    if (p.total_ticks == std::numeric_limits<std::uint64_t>::max())
+        fmt::print("marionette: {} run, {} at {} Hz until the window is closed{}\n", render::platform_name(kind), source,
+                   config.tick_rate_hz, o.fast ? " (no real-time pacing)" : "");
+    else
+        fmt::print("marionette: {} run, {} at {} Hz for {:.1f} s{}\n", render::platform_name(kind), source,
+                   config.tick_rate_hz, static_cast<double>(p.total_ticks) / config.tick_rate_hz,
+                   o.fast ? " (no real-time pacing)" : "");
     if (!o.config_file.empty()) fmt::print("marionette: watching {} for live tuning\n", o.config_file);
     std::fflush(stdout);
 
@@ -136,7 +161,18 @@ int run_command(const RunOptions& o) {
     g_stop_requested_ns.store(0);
     std::signal(SIGINT, on_stop_signal);
     std::signal(SIGTERM, on_stop_signal);
-    const PipelineResult r = run_pipeline(p);
+    PipelineResult r;
+    try {
+        r = run_pipeline(p);
+    } catch (const render::PlatformError& e) {
+        if (request != render::PlatformRequest::automatic) throw;
+        // auto found a display it could not open: say so and run headless.
+        fmt::print(stderr, "warning: {}; running headless\n", e.what());
+        p.display.gl = false;
+        if (o.duration_s < 0.0) p.total_ticks = headless_ticks;
+        r = run_pipeline(p);
+    }
+    if (!r.display_description.empty()) fmt::print("display: {}\n", r.display_description);
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
 
@@ -144,7 +180,7 @@ int run_command(const RunOptions& o) {
     fmt::print("{}: {:.1f} s, {} ticks; walked {:.1f} m, top speed {:.2f} m/s; {} catch-up drops; "
                "input→tick latency p50 {:.2f} ms p99 {:.2f} ms max {:.2f} ms; {} samples dropped; {} frames ({} missed); "
                "final state hash {:016x}\n",
-               r.stopped ? "stopped" : "demo finished", static_cast<double>(r.ticks) / config.tick_rate_hz, r.ticks,
+               r.stopped ? "stopped" : (r.display_closed ? "window closed" : "demo finished"), static_cast<double>(r.ticks) / config.tick_rate_hz, r.ticks,
                r.distance_m, r.top_speed, r.catch_up_drops, r.input_latency.quantile_ns(0.5) / 1e6,
                r.input_latency.quantile_ns(0.99) / 1e6, r.input_latency.max_ns / 1e6, r.samples_dropped, r.frames,
                r.missed_frames, r.final_hash);
@@ -164,9 +200,7 @@ void register_run_command(CLI::App& app, int& exit_code) {
     cmd->add_option("--config", o->config_file, "TOML file overriding the defaults; watched for live tuning")
         ->check(CLI::ExistingFile);
     cmd->add_option("--input", o->input, "auto|evdev|hidapi|sdl|sim:PROGRAM|log:FILE (PROGRAM: a file or builtin:NAME)");
-    cmd->add_option("--render-config", o->render_config_file, "render settings TOML overriding config/render.toml")
-        ->check(CLI::ExistingFile);
-    cmd->add_option("--display", o->display, "auto|kms|window|headless (auto: a window under X11/Wayland, KMS on a console, else none)")
+    cmd->add_option("--display", o->display, "auto|kms|window|headless")
         ->check(CLI::IsMember({"auto", "headless", "kms", "window"}));
     cmd->add_option("--record", o->record_file, "write the input log here");
     cmd->add_option("--trace", o->trace_file, "per-tick CSV: tick,hash,root_x,root_y,root_z (as replay --trace)");

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string>
 
+#include "runtime/gait_prototype.hpp"
 #include "runtime/terrain.hpp"
 
 namespace marionette {
@@ -39,6 +40,26 @@ struct SimConfig {
     float stick_deadzone = 0.12f;          // radial, fraction of full deflection
     float response_curve = 0.5f;           // 0 linear … 1 quadratic: f(d) = (1−c)·d + c·d²
 
+    // [gait] the spline-IK gait (docs/gait.md)
+    float gait_pelvis_height = 0.84f;      // hip height above the mean foot ground while stepping
+    float step_length_multiplier = 0.45f;  // step length = multiplier · sqrt(speed)
+    float min_step_duration = 0.26f;       // s, fastest cadence
+    float max_step_duration = 0.6f;        // s, slowest cadence (slow walk, turning in place)
+    float walk_duty = 0.58f;               // fraction of a cycle each foot is down when walking (> 0.5)
+    float run_duty = 0.36f;                // … when running (< 0.5: flight phase)
+    float run_threshold = 1.9f;            // m/s: above it the gait runs
+    float swing_clearance = 0.03f;         // m the swing sole keeps above the ground between its ends
+    float spine_lean_deg_per_m_s = 4.0f;   // forward lean per unit speed
+    float max_spine_lean_deg = 10.0f;
+    float interpolation_rate = 8.0f;       // 1/s: lean, walk/run blend and pelvis height approach their targets
+    float slope_speed_factor = 0.01f;      // speed reduction per degree of slope along the heading
+    float turn_in_place_deg = 120.0f;      // reversals wider than this turn in place
+    float stop_transition_s = 0.3f;        // the swing foot's time to plant after a stop, at most
+    float breath_amplitude = 0.005f;       // m of pelvis rise when idle
+    float breath_period_s = 4.0f;
+    GaitPrototypes walk = default_walk_prototypes();   // [gait.walk]
+    GaitPrototypes run = default_run_prototypes();     // [gait.run]
+
     // [terrain] the ground walked on: `name` is where it came from (a built-in
     // name or a file path, resolved by app/); the data travel inline in every
     // effective configuration, so a log fully determines its ground. Built-in
@@ -54,6 +75,16 @@ struct SimConfig {
     std::int32_t simulation_cpu = -1;
     std::int32_t render_cpu = -1;
     std::int32_t lock_memory = 0;          // 1: mlockall(MCL_CURRENT | MCL_FUTURE) before the threads start
+    // [motion_graph] build parameters and path costs (docs/motion-graph.md)
+    std::int32_t graph_analysis_rate_hz = 30;     // clips are resampled to this rate for the build
+    std::int32_t graph_window_frames = 10;        // k: distance window and transition length
+    std::int32_t graph_neighbourhood_frames = 4;  // local minima over (2h+1)² pairs
+    float graph_threshold_percentile = 5.0f;      // threshold as a percentile of all distances
+    float graph_threshold_absolute = 0.0f;        // > 0: absolute threshold (leg lengths²) instead
+    float graph_bridge_percentile = 90.0f;        // looser percentile for bridges into cut-off clips
+    float graph_contact_height = 0.08f;           // foot contact: height above ground, leg lengths
+    float graph_contact_speed = 0.6f;             // foot contact: speed, leg lengths per second
+    float graph_transition_weight = 1.0f;         // path cost: seconds per unit of transition distance
 };
 
 }  // namespace marionette

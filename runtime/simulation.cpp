@@ -4,6 +4,7 @@
 #define XXH_STATIC_LINKING_ONLY
 #include <xxhash.h>
 
+#include <initializer_list>
 #include <stdexcept>
 
 #include "runtime/puppet.hpp"
@@ -17,15 +18,38 @@ namespace marionette {
 namespace {
 float clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
 
-// Stick deflection → speed fraction: radial deadzone, then the response curve.
-float stick_response(float deflection, const SimConfig& c) {
-    if (deflection <= c.stick_deadzone) return 0.0f;
-    float d = (deflection - c.stick_deadzone) / (1.0f - c.stick_deadzone);
-    d = clampf(d, 0.0f, 1.0f);
-    return (1.0f - c.response_curve) * d + c.response_curve * d * d;
+void hash_floats(XXH64_state_t* h, const float* v, size_t n) { XXH64_update(h, v, n * sizeof(float)); }
+void hash_ints(XXH64_state_t* h, std::initializer_list<std::int32_t> v) { XXH64_update(h, v.begin(), v.size() * sizeof(std::int32_t)); }
+void hash_vec(XXH64_state_t* h, vec3 v) {
+    const float f[3] = {v.x, v.y, v.z};
+    hash_floats(h, f, 3);
+}
+void hash_quat(XXH64_state_t* h, quat q) {
+    const float f[4] = {q.w, q.x, q.y, q.z};
+    hash_floats(h, f, 4);
 }
 
-void hash_floats(XXH64_state_t* h, const float* v, size_t n) { XXH64_update(h, v, n * sizeof(float)); }
+// Every field of the gait state, one by one (no padding enters the hash).
+void hash_gait(XXH64_state_t* h, const GaitState& g) {
+    for (const FootState& f : g.feet) {
+        hash_vec(h, f.ankle);
+        hash_quat(h, f.rotation);
+        hash_vec(h, f.start);
+        hash_quat(h, f.start_rotation);
+        hash_vec(h, f.target);
+        hash_quat(h, f.target_rotation);
+        const float scalars[8] = {f.ground, f.start_ground, f.target_ground, f.progress, f.fraction, f.lift_phase, f.timed_rate, f.lift_scale};
+        hash_floats(h, scalars, 8);
+        hash_floats(h, f.envelope.data(), f.envelope.size());
+        hash_ints(h, {f.swinging, f.replanned});
+        const float plan[2] = {f.planned_speed, f.planned_heading};
+        hash_floats(h, plan, 2);
+    }
+    hash_vec(h, g.pelvis);
+    const float scalars[7] = {g.cycle_phase, g.speed, g.commanded_speed, g.run_blend, g.pelvis_base, g.lean, g.activity};
+    hash_floats(h, scalars, 7);
+    hash_ints(h, {static_cast<std::int32_t>(g.mode), g.turning_in_place, g.first_step, g.steps, g.flight_phases, g.flight_phases_open});
+}
 }  // namespace
 
 void set_simulation_float_mode() {
@@ -46,12 +70,12 @@ Simulation::Simulation(const SimConfig& config, const Terrain& terrain) : config
     idle_clip_ = make_idle_clip(skeleton, config_);
     walk_clip_ = make_walk_clip(skeleton, config_);
     clip_data_hash_ = hash_clip(idle_clip_) ^ (hash_clip(walk_clip_) * 0x9E3779B97F4A7C15ull);
-    // Tick 0: the idle pose at time 0, so even a run of no ticks has a full pose.
+    // Tick 0: standing on the terrain at the origin, so even a run of no ticks has a full pose.
     state_.joint_count = skeleton.joint_count();
-    const size_t n = static_cast<size_t>(skeleton.joint_count());
-    sample_clip(idle_clip_, 0.0, ClipWrap::loop, std::span<quat>(state_.local_rotations.data(), n),
-                std::span<vec3>(state_.local_translations.data(), n));
-    update_model_space();
+    rig_ = make_gait_rig(config_);
+    state_.gait = initial_gait_state(config_, rig_, terrain_, vec3(0.0f), 0.0f);
+    state_.root_position = vec3(0.0f, state_.gait.pelvis_base, 0.0f);
+    pose_from_gait();
 }
 
 std::string structural_change(const SimConfig& c, const SimConfig& next) {
@@ -69,18 +93,26 @@ std::string structural_change(const SimConfig& c, const SimConfig& next) {
 
 std::string Simulation::retune(const SimConfig& next) {
     std::string key = structural_change(config_, next);
-    if (key.empty()) config_ = next;
-    return key;
+    if (!key.empty()) return key;
+    config_ = next;
+    rig_ = make_gait_rig(config_);
+    return {};
 }
 
-void Simulation::update_model_space() {
+void Simulation::pose_from_gait() {
     const size_t n = static_cast<size_t>(state_.joint_count);
-    LocalToModelJob fk{std::span<const int>(skeleton().parents),
-                       std::span<const quat>(state_.local_rotations.data(), n),
-                       std::span<const vec3>(state_.local_translations.data(), n),
-                       std::span<quat>(state_.model_rotations.data(), n),
-                       std::span<vec3>(state_.model_positions.data(), n)};
-    fk.run();
+    const GaitPoseJob job{&state_.gait,
+                          &rig_,
+                          &config_,
+                          state_.heading,
+                          state_.idle_time,
+                          std::span<const int>(skeleton().parents),
+                          std::span<const vec3>(skeleton().rest_offsets),
+                          std::span<quat>(state_.local_rotations.data(), n),
+                          std::span<vec3>(state_.local_translations.data(), n),
+                          std::span<quat>(state_.model_rotations.data(), n),
+                          std::span<vec3>(state_.model_positions.data(), n)};
+    job.run();
 }
 
 void Simulation::step(const TickInput& input) {
@@ -89,56 +121,18 @@ void Simulation::step(const TickInput& input) {
     PuppetState& s = state_;
     s.input = input;
 
-    // Commanded velocity. Stick up moves away from the camera (−Z), right is +X.
-    const float sx = static_cast<float>(input.left_x) / kStickScale;
-    const float sy = static_cast<float>(input.left_y) / kStickScale;
-    const float deflection = std::sqrt(sx * sx + sy * sy);
-    const float speed_fraction = stick_response(deflection > 1.0f ? 1.0f : deflection, c);
-    vec2 desired(0.0f);
-    if (speed_fraction > 0.0f) {
-        const float scale = c.max_speed * speed_fraction / deflection;
-        desired = vec2(sx * scale, -sy * scale);
-    }
-
-    // Accelerate toward it, limited by the configured acceleration.
-    const vec2 dv = desired - s.velocity;
-    const float dv_len = std::sqrt(dv.x * dv.x + dv.y * dv.y);
-    const float max_dv = c.acceleration * dt;
-    s.velocity = dv_len <= max_dv ? desired : s.velocity + dv * (max_dv / dv_len);
-    s.root_position.x += s.velocity.x * dt;
-    s.root_position.z += s.velocity.y * dt;
-    const float speed = std::sqrt(s.velocity.x * s.velocity.x + s.velocity.y * s.velocity.y);
-
-    // Heading turns toward the direction of travel at the configured rate.
-    if (speed > 0.05f) {
-        const double target = det::atan2(s.velocity.x, s.velocity.y);
-        const double diff = det::wrap_angle(target - s.heading);
-        const double max_turn = c.turn_rate_deg_s * det::kDegToRad * dt;
-        const double turn = diff > max_turn ? max_turn : (diff < -max_turn ? -max_turn : diff);
-        s.heading = static_cast<float>(det::wrap_angle(s.heading + turn));
-    }
-
-    // Clip playback: the walk cycle advances with distance travelled, idle with time.
-    s.locomotion_blend = clampf(speed / c.walk_cycle_speed, 0.0f, 1.0f);
-    s.walk_phase += speed * dt / c.stride_length;
-    s.walk_phase -= static_cast<float>(static_cast<int>(s.walk_phase));
+    // The gait plans (stick → velocity, steps, pelvis); the pose comes from its state.
+    GaitTickInput gait_input;
+    gait_input.stick_x = static_cast<float>(input.left_x) / kStickScale;
+    gait_input.stick_y = static_cast<float>(input.left_y) / kStickScale;
+    gait_input.dt = dt;
+    gait_input.breath_time = s.idle_time;
+    update_gait(s.gait, s.root_position, s.heading, s.velocity, gait_input, c, rig_, terrain_);
+    s.locomotion_blend = clampf(s.gait.speed / c.walk_cycle_speed, 0.0f, 1.0f);
+    s.walk_phase = s.gait.cycle_phase;
     s.idle_time += dt;
-    if (s.idle_time >= static_cast<float>(idle_clip_.duration())) s.idle_time -= static_cast<float>(idle_clip_.duration());
-
-    const size_t n = static_cast<size_t>(s.joint_count);
-    sample_clip(idle_clip_, s.idle_time, ClipWrap::loop, std::span<quat>(s.local_rotations.data(), n),
-                std::span<vec3>(s.local_translations.data(), n));
-    sample_clip(walk_clip_, s.walk_phase * walk_clip_.duration(), ClipWrap::loop,
-                std::span<quat>(walk_rotations_.data(), n), std::span<vec3>(walk_translations_.data(), n));
-    for (size_t j = 0; j < n; ++j) {
-        s.local_rotations[j] = quat_slerp(s.local_rotations[j], walk_rotations_[j], s.locomotion_blend);
-        s.local_translations[j] = lerp(s.local_translations[j], walk_translations_[j], s.locomotion_blend);
-    }
-    // Place the root: clip height over the ground point, facing the heading.
-    s.local_rotations[0] = quat_mul(quat_axis_angle(vec3(0, 1, 0), s.heading), s.local_rotations[0]);
-    s.local_translations[0] = vec3(s.root_position.x, s.root_position.y + s.local_translations[0].y, s.root_position.z);
-
-    update_model_space();
+    if (s.idle_time >= c.breath_period_s) s.idle_time -= c.breath_period_s;
+    pose_from_gait();
     ++s.tick;
 }
 
@@ -157,6 +151,7 @@ std::uint64_t hash_state(const PuppetState& s) {
                               s.velocity.y, s.heading, s.walk_phase, s.idle_time};
     hash_floats(h, scalars, 8);
     hash_floats(h, &s.locomotion_blend, 1);
+    hash_gait(h, s.gait);
     const int n = s.joint_count < 0 ? 0 : (s.joint_count > kMaxJoints ? kMaxJoints : s.joint_count);
     for (int j = 0; j < n; ++j) {
         const size_t i = static_cast<size_t>(j);

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "runtime/clip.hpp"
+#include "runtime/gait.hpp"
 #include "runtime/sim_config.hpp"
 #include "runtime/terrain.hpp"
 #include "runtime/tick_input.hpp"
@@ -25,6 +26,7 @@ struct PuppetState {
     float walk_phase = 0.0f;           // [0, 1) through the walk cycle
     float idle_time = 0.0f;            // seconds into the idle clip
     float locomotion_blend = 0.0f;     // 0 idle … 1 walking
+    GaitState gait{};                  // the spline-IK gait's plan (runtime/gait.hpp)
     std::array<quat, kMaxJoints> local_rotations{};
     std::array<vec3, kMaxJoints> local_translations{};
     std::array<quat, kMaxJoints> model_rotations{};   // world space
@@ -60,17 +62,15 @@ public:
     std::uint64_t clip_data_hash() const { return clip_data_hash_; }
 
 private:
-    void update_model_space();
+    void pose_from_gait();
 
     SimConfig config_;
     Terrain terrain_;
     Clip idle_clip_;
     Clip walk_clip_;
     std::uint64_t clip_data_hash_ = 0;
+    GaitRig rig_;
     PuppetState state_;
-    // Scratch for the blend (fixed size: no allocation in step()).
-    std::array<quat, kMaxJoints> walk_rotations_{};
-    std::array<vec3, kMaxJoints> walk_translations_{};
 };
 
 // The first structural setting (one that cannot change while running: tick rate,

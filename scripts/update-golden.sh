@@ -9,7 +9,7 @@ cmake --build --preset release --target marionette
 bin=build/release/app/marionette
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-for program in stand_still walk_stop circle demo; do
+for program in stand_still walk_stop circle demo slow_walk fast_walk run start_stop full_circle reversals stop_mid_step; do
   "$bin" record --program "config/programs/$program.prog" -o "$tmp/$program.mlog" >/dev/null
   "$bin" replay "$tmp/$program.mlog" --trace "tests/golden/$program.trace.csv"
 done

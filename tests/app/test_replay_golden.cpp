@@ -35,7 +35,8 @@ std::vector<std::string> lines_of(const std::string& text) {
 
 TEST_CASE("replays of the shipped programs match the committed golden traces", "[golden]") {
     const SimConfig config = default_config();
-    for (const std::string name : {"stand_still", "walk_stop", "circle", "demo"}) {
+    for (const std::string name : {"stand_still", "walk_stop", "circle", "demo", "slow_walk", "fast_walk", "run", "start_stop",
+                                   "full_circle", "reversals", "stop_mid_step"}) {
         INFO("program " << name);
         const DecodedInputLog log = decode_input_log(record("builtin:" + name, config), name);
         REQUIRE(log.warning.empty());

@@ -22,7 +22,7 @@ expect_error() {  # expect_error "what" exit_code "message substring" command...
     echo "FAILED: $what (exit $rc, stderr: $(cat err.txt))"; failures=$((failures + 1)); fi
 }
 
-for program in stand_still walk_stop circle demo; do
+for program in stand_still walk_stop circle demo slow_walk fast_walk run start_stop full_circle reversals stop_mid_step; do
   "$bin" record --program "$src/config/programs/$program.prog" -o "$program.mlog" --json >rec.json
   rec_hash=$(sed -E 's/.*"final_hash":"([0-9a-f]+)".*/\1/' rec.json)
   h1=$("$bin" replay "$program.mlog" --hash)
@@ -75,6 +75,28 @@ expect_error "unknown clip format" 2 "unknown clip format" "$bin" clip info bad.
 expect_error "frame out of range" 2 "frame 5000 is out of range" "$bin" clip fk perf.bvh --frame 5000
 expect_error "bad command line" 106 "--frame is required" "$bin" clip fk perf.bvh
 expect_error "no subcommand" 106 "subcommand" "$bin"
+
+# Motion graph (docs/motion-graph.md): the build command on the shared CMU
+# subject-16 clips, info, paths between kept clips, BVH export, and bad input.
+mocap=${MARIONETTE_MOCAP_DIR:-$src/../shared/data/mocap}
+if [[ -d $mocap/cmu_amc_16 ]]; then
+  "$bin" graph build --asf "$mocap/cmu_amc_16/16.asf" "$mocap"/cmu_amc_16/*.amc -o cmu16.mgraph --json --dot g.dot --plot m.png >build.json
+  check "graph build --json has the issue's keys" python3 -c "import json,sys; d=json.load(open('build.json')); sys.exit(0 if all(k in d for k in ['frames','candidates','nodes_before','edges_before','nodes','edges','frames_kept_pct','clips_kept','build_seconds','peak_rss_mb']) else 1)"
+  check "graph build keeps walk, run and turn clips" python3 -c "import json,sys; k=json.load(open('build.json'))['clips_kept']; sys.exit(0 if {'16_15','16_35','16_17','16_41'} <= set(k) else 1)"
+  check "graph build writes a PNG plot" bash -c "head -c 8 m.png | od -An -c | grep -q 'P   N   G'"
+  check "graph build writes a Graphviz graph" grep -q '^digraph motion_graph' g.dot
+  "$bin" graph info cmu16.mgraph --json >info.json
+  check "graph info reports the pruned graph" python3 -c "import json,sys; a=json.load(open('info.json')); b=json.load(open('build.json')); sys.exit(0 if a['nodes']==b['nodes'] and a['edges']==b['edges'] else 1)"
+  check "graph path finds a walk → run path and writes its BVH" bash -c "'$bin' graph path cmu16.mgraph --from 16_15:40 --to 16_35:20 --json --bvh path.bvh >path.json"
+  check "the path BVH imports" bash -c "'$bin' clip info path.bvh --json | grep -q '\"joints\":31'"
+  check "graph path reaches a label" bash -c "'$bin' graph path cmu16.mgraph --from 16_41:20 --to walk --json | grep -q '\"found\":true'"
+  expect_error "graph path: unknown label" 2 "neither CLIP:FRAME nor a label" "$bin" graph path cmu16.mgraph --from 16_15:40 --to dance
+  expect_error "graph path: frame out of range" 2 "expected a 0-based frame index" "$bin" graph path cmu16.mgraph --from 16_15:9999 --to walk
+  head -c 100 cmu16.mgraph >cut.mgraph
+  expect_error "graph info: truncated graph" 2 "cut.mgraph: at byte 24" "$bin" graph info cut.mgraph
+  expect_error "graph build: AMC without skeleton" 2 "needs its skeleton" "$bin" graph build "$mocap/cmu_amc_16/16_15.amc" -o x.mgraph
+  expect_error "graph build: mixed skeletons" 2 "skeleton differs" "$bin" graph build --asf "$mocap/cmu_amc_16/16.asf" "$mocap/cmu_amc_16/16_15.amc" "$mocap/cmu_bvh_131/131_01.bvh" -o x.mgraph
+fi
 
 echo "cli: $passes passed, $failures failed"
 [[ $failures -eq 0 ]]

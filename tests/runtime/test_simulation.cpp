@@ -58,7 +58,8 @@ TEST_CASE("the left stick drives the root: speed, direction and heading", "[simu
     const PuppetState& s = sim.state();
     CHECK(speed_of(s) == Approx(config.max_speed).epsilon(1e-4));
     CHECK(s.root_position.z < -6.0f);       // up moves away from the camera (−Z)
-    CHECK(std::abs(s.root_position.x) < 1e-4f);
+    // The reversal turns in place, then finishes its last degrees while speeding up.
+    CHECK(std::abs(s.root_position.x) < 0.005f);
     CHECK(std::abs(std::abs(s.heading) - det::kPi) < 1e-3);  // facing −Z
     CHECK(s.locomotion_blend == 1.0f);
     for (int k = 0; k < 240 * 2; ++k) sim.step(stick(0, 0));  // release: decelerate and stand

@@ -1,0 +1,209 @@
+#include "app/gait_eval.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <vector>
+
+#include "runtime/gait.hpp"
+#include "runtime/puppet.hpp"
+#include "runtime/simulation.hpp"
+
+namespace marionette {
+
+namespace {
+
+// How far above the ground a sole counts as off it (entering) and on it again.
+constexpr double kAirborneM = 0.005;
+constexpr double kGroundedM = 0.002;
+// A hold is measured after this settling time, if at least kMinWindowS remain.
+constexpr double kSettleS = 1.5;
+constexpr double kMinWindowS = 1.0;
+
+struct FootPoints {
+    vec3 points[4];  // ankle, sole under the ankle, ball (toe joint), toe tip
+};
+
+FootPoints foot_points(const PuppetState& s, int foot_joint, const SimConfig& c) {
+    const std::size_t f = static_cast<std::size_t>(foot_joint);
+    const vec3 ankle = s.model_positions[f];
+    const vec3 toe = s.model_positions[f + 1];
+    return {{ankle, ankle + quat_rotate(s.model_rotations[f], vec3(0.0f, -c.ankle_height, 0.0f)), toe,
+             toe + quat_rotate(s.model_rotations[f + 1], vec3(0.0f, 0.0f, c.toe_length))}};
+}
+
+struct Hold {
+    std::uint64_t first_tick;
+    std::uint64_t end_tick;  // exclusive
+    float stick_x, stick_y;
+};
+
+// The program's holds with the stick out of the deadzone, as tick ranges.
+std::vector<Hold> moving_holds(const StickProgram& program, const SimConfig& c) {
+    std::vector<Hold> holds;
+    double t = 0.0;
+    StickValues v;
+    for (const StickSegment& seg : program.segments) {
+        const double start = t;
+        t += seg.duration_s;
+        if (seg.kind == StickSegment::Kind::hold || seg.kind == StickSegment::Kind::ramp) {
+            if (seg.set_mask & 1) v.lx = seg.target.lx;
+            if (seg.set_mask & 2) v.ly = seg.target.ly;
+        }
+        if (seg.kind == StickSegment::Kind::circle && !seg.right_stick) {
+            // Ends where it started turning plus the turns; keep the last value unknown.
+            v.lx = 0.0;
+            v.ly = 0.0;
+            continue;
+        }
+        if (seg.kind != StickSegment::Kind::hold) continue;
+        const double deflection = std::sqrt(v.lx * v.lx + v.ly * v.ly);
+        if (stick_speed_fraction(static_cast<float>(deflection > 1.0 ? 1.0 : deflection), c) <= 0.0f) continue;
+        const double window = seg.duration_s - kSettleS;
+        if (window < kMinWindowS) continue;
+        holds.push_back({static_cast<std::uint64_t>(std::llround((start + kSettleS) * c.tick_rate_hz)),
+                         static_cast<std::uint64_t>(std::llround(t * c.tick_rate_hz)), static_cast<float>(v.lx),
+                         static_cast<float>(v.ly)});
+    }
+    return holds;
+}
+
+}  // namespace
+
+std::string gait_limit_failures(const GaitMetrics& m) {
+    std::string out;
+    auto check = [&](const char* name, double value, double limit) {
+        if (!(value < limit)) out += fmt::format("{}{} = {:.3f} (limit < {})", out.empty() ? "" : "; ", name, value, limit);
+    };
+    check("foot_skate_mm", m.foot_skate_mm, kMaxFootSkateMm);
+    check("penetration_mm", m.penetration_mm, kMaxPenetrationMm);
+    check("speed_error_pct", m.speed_error_pct, kMaxSpeedErrorPct);
+    check("max_joint_speed_deg_s", m.max_joint_speed_deg_s, kMaxJointSpeedDegS);
+    return out;
+}
+
+GaitMetrics evaluate_gait(const SimConfig& config, const StickProgram& program, const std::string& feet_csv) {
+    std::string csv;
+    if (!feet_csv.empty())
+        csv = "tick,phase,speed,mode,pelvis_y,foot,swinging,progress,ankle_x,ankle_y,ankle_z,target_x,target_z,ankle_clear,sole_clear,ball_clear,tip_clear\n";
+    const std::vector<TickInput> ticks = render_stick_program(program, config.tick_rate_hz);
+    const std::vector<Hold> holds = moving_holds(program, config);
+    set_simulation_float_mode();
+    Simulation sim(config);
+    const Terrain& terrain = sim.terrain();
+    const int feet[2] = {kFootL, kFootR};
+    GaitMetrics m;
+
+    PuppetState previous = sim.state();
+    bool airborne[2] = {false, false};
+    bool in_flight = false;
+    vec3 stance_anchor[2] = {sim.state().model_positions[kFootL], sim.state().model_positions[kFootR]};
+    bool was_stance[2] = {true, true};
+    // Per hold: pelvis path length (sampled every quarter second) and expected speed.
+    std::vector<double> path(holds.size(), 0.0), expected(holds.size(), 0.0);
+    std::vector<vec3> last_sample(holds.size());
+    const std::uint64_t sample_every = static_cast<std::uint64_t>(config.tick_rate_hz / 4);
+
+    for (std::uint64_t k = 0; k < ticks.size(); ++k) {
+        sim.step(ticks[k]);
+        const PuppetState& s = sim.state();
+        for (int i = 0; i < 2; ++i) {
+            const FootPoints fp = foot_points(s, feet[i], config);
+            double lowest = 1e9;
+            static const char* const kPointNames[4] = {"ankle", "sole under the ankle", "ball", "toe tip"};
+            for (int p_index = 0; p_index < 4; ++p_index) {
+                const vec3& p = fp.points[p_index];
+                const double clearance = static_cast<double>(p.y) - query_ground(terrain, p.x, p.z).height;
+                if (-clearance * 1000.0 > m.penetration_mm) {
+                    m.penetration_mm = -clearance * 1000.0;
+                    m.deepest_tick = s.tick;
+                    m.deepest_point = fmt::format("{} {} ({})", i == 0 ? "left" : "right", kPointNames[p_index],
+                                                  s.gait.feet[static_cast<std::size_t>(i)].swinging ? "swing" : "stance");
+                }
+                lowest = std::min(lowest, clearance);
+            }
+            if (!feet_csv.empty()) {
+                const FootState& f = s.gait.feet[static_cast<std::size_t>(i)];
+                csv += fmt::format("{},{:.4f},{:.3f},{},{:.4f},{},{},{:.3f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f}", s.tick, s.gait.cycle_phase, s.gait.speed,
+                                   static_cast<int>(s.gait.mode), s.gait.pelvis.y, i, f.swinging, f.progress, fp.points[0].x,
+                                   fp.points[0].y, fp.points[0].z, f.target.x, f.target.z);
+                for (const vec3& p : fp.points) csv += fmt::format(",{:.4f}", p.y - query_ground(terrain, p.x, p.z).height);
+                csv += "\n";
+            }
+            if (!airborne[i] && lowest > kAirborneM) airborne[i] = true;
+            else if (airborne[i] && lowest <= kGroundedM) {
+                airborne[i] = false;
+                ++m.steps;
+            }
+            // Skate: while the gait holds the foot in stance, its joint must not move.
+            const bool stance = s.gait.feet[static_cast<std::size_t>(i)].swinging == 0;
+            const vec3 ankle = s.model_positions[static_cast<std::size_t>(feet[i])];
+            if (stance && !was_stance[i]) stance_anchor[i] = ankle;
+            if (stance) {
+                const double dx = ankle.x - stance_anchor[i].x, dz = ankle.z - stance_anchor[i].z;
+                const double skate = std::sqrt(dx * dx + dz * dz) * 1000.0;
+                if (skate > m.foot_skate_mm) {
+                    m.foot_skate_mm = skate;
+                    m.skate_tick = s.tick;
+                }
+            }
+            was_stance[i] = stance;
+        }
+        if (!in_flight && airborne[0] && airborne[1]) {
+            in_flight = true;
+            ++m.flight_phases;
+        } else if (in_flight && (!airborne[0] || !airborne[1])) {
+            in_flight = false;
+        }
+        const double dt_rate = config.tick_rate_hz;
+        for (int j = 0; j < s.joint_count; ++j) {
+            const std::size_t i = static_cast<std::size_t>(j);
+            const double speed = quat_angle_between(previous.local_rotations[i], s.local_rotations[i]) * dt_rate * det::kRadToDeg;
+            if (speed > m.max_joint_speed_deg_s) {
+                m.max_joint_speed_deg_s = speed;
+                m.fastest_joint = sim.skeleton().joint_names[i];
+                m.fastest_joint_tick = s.tick;
+            }
+        }
+        // Speed over the holds: measured from the pelvis joint; expected from the
+        // stick through the documented response curve and slope factor.
+        const vec3 pelvis = s.model_positions[kPelvis];
+        for (std::size_t h = 0; h < holds.size(); ++h) {
+            const Hold& hold = holds[h];
+            if (k < hold.first_tick || k >= hold.end_tick) continue;
+            const float deflection = std::min(1.0f, std::sqrt(hold.stick_x * hold.stick_x + hold.stick_y * hold.stick_y));
+            expected[h] += config.max_speed * stick_speed_fraction(deflection, config) *
+                           slope_speed_multiplier(terrain, config, pelvis.x, pelvis.z, s.heading);
+            if (k == hold.first_tick) last_sample[h] = pelvis;
+            else if ((k - hold.first_tick) % sample_every == 0 || k + 1 == hold.end_tick) {
+                const double dx = pelvis.x - last_sample[h].x, dz = pelvis.z - last_sample[h].z;
+                path[h] += std::sqrt(dx * dx + dz * dz);
+                last_sample[h] = pelvis;
+            }
+        }
+        previous = s;
+    }
+    for (std::size_t h = 0; h < holds.size(); ++h) {
+        const double n = static_cast<double>(holds[h].end_tick - holds[h].first_tick);
+        if (holds[h].end_tick > ticks.size() || n < 2) continue;
+        const double seconds = (n - 1) / config.tick_rate_hz;
+        const double actual = path[h] / seconds;
+        const double want = expected[h] / n;
+        if (want <= 0.0) continue;
+        m.speed_error_pct = std::max(m.speed_error_pct, std::fabs(actual - want) / want * 100.0);
+        ++m.speed_windows;
+    }
+    if (!feet_csv.empty()) {
+        std::FILE* out = std::fopen(feet_csv.c_str(), "wb");
+        if (!out || std::fwrite(csv.data(), 1, csv.size(), out) != csv.size())
+            throw std::runtime_error(feet_csv + ": cannot write the feet CSV");
+        std::fclose(out);
+    }
+    m.ticks = ticks.size();
+    m.final_hash = hash_state(sim.state());
+    return m;
+}
+
+}  // namespace marionette

@@ -1,0 +1,44 @@
+#pragma once
+// Measures a gait run (docs/gait.md, "Metrics"): the simulation runs headless over
+// a stick program and every metric is computed from the simulated joint
+// positions against the terrain, not from what the planner intended.
+#include <cstdint>
+#include <string>
+
+#include "runtime/sim_config.hpp"
+#include "runtime/stick_program.hpp"
+
+namespace marionette {
+
+struct GaitMetrics {
+    double foot_skate_mm = 0.0;          // largest horizontal drift of a foot joint during one stance
+    double penetration_mm = 0.0;         // deepest sole or toe point below the surface
+    double speed_error_pct = 0.0;        // worst steady-state speed error over the program's holds
+    double max_joint_speed_deg_s = 0.0;  // largest angular speed of any joint's local rotation
+    int steps = 0;                       // touchdowns seen in the sole heights
+    int flight_phases = 0;               // intervals with both feet off the ground
+    int speed_windows = 0;               // holds long enough to measure the speed over
+    std::uint64_t ticks = 0;
+    std::uint64_t final_hash = 0;
+    // Where the worst values happened, for diagnosis.
+    std::string fastest_joint;
+    std::uint64_t fastest_joint_tick = 0;
+    std::uint64_t deepest_tick = 0;
+    std::string deepest_point;           // e.g. "foot_l toe tip (swing)"
+    std::uint64_t skate_tick = 0;
+};
+
+// The limits (docs/gait.md).
+inline constexpr double kMaxFootSkateMm = 0.5;
+inline constexpr double kMaxPenetrationMm = 1.0;
+inline constexpr double kMaxSpeedErrorPct = 2.0;
+inline constexpr double kMaxJointSpeedDegS = 1500.0;
+
+// Empty when every limit holds, else which failed and by how much.
+std::string gait_limit_failures(const GaitMetrics& metrics);
+
+// `feet_csv`: when not empty, a per-tick CSV of both feet (swing flag, progress,
+// each sole point's height above the ground) is written there, for diagnosis.
+GaitMetrics evaluate_gait(const SimConfig& config, const StickProgram& program, const std::string& feet_csv = {});
+
+}  // namespace marionette

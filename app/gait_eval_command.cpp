@@ -1,0 +1,75 @@
+// `marionette gait-eval`: runs the gait headless over a stick program on a terrain
+// and prints the metrics of docs/gait.md; --check makes a broken limit exit 1.
+#include <fmt/format.h>
+
+#include <memory>
+
+#include "app/cli.hpp"
+#include "app/config.hpp"
+#include "app/gait_eval.hpp"
+#include "app/json.hpp"
+#include "app/program_source.hpp"
+#include "app/terrain_file.hpp"
+
+namespace marionette {
+
+namespace {
+struct GaitEvalOptions {
+    std::string terrain;
+    std::string program;
+    std::string config_file;
+    std::string feet_csv;
+    bool json = false;
+    bool check = false;
+};
+
+int gait_eval_command(const GaitEvalOptions& o) {
+    SimConfig config = load_config(o.config_file);
+    if (!o.terrain.empty()) {
+        config.terrain = load_terrain(o.terrain);
+        config.terrain_name = o.terrain;
+    }
+    const StickProgram program = load_program(o.program);
+    const GaitMetrics m = evaluate_gait(config, program, o.feet_csv);
+    const std::string failures = gait_limit_failures(m);
+    if (o.json) {
+        fmt::print("{{\"terrain\":{},\"program\":{},\"ticks\":{},\"foot_skate_mm\":{},\"penetration_mm\":{},"
+                   "\"speed_error_pct\":{},\"speed_windows\":{},\"max_joint_speed_deg_s\":{},\"steps\":{},"
+                   "\"flight_phases\":{},\"final_hash\":\"{:016x}\",\"limits_ok\":{}}}\n",
+                   json::quote(config.terrain_name), json::quote(o.program), m.ticks, json::number(m.foot_skate_mm),
+                   json::number(m.penetration_mm), json::number(m.speed_error_pct), m.speed_windows,
+                   json::number(m.max_joint_speed_deg_s), m.steps, m.flight_phases, m.final_hash,
+                   failures.empty() ? "true" : "false");
+    } else {
+        fmt::print("gait-eval: {} on {} ({} ticks)\n", o.program, config.terrain_name, m.ticks);
+        fmt::print("  foot_skate_mm          {:10.4f}  (limit < {}; worst at tick {})\n", m.foot_skate_mm, kMaxFootSkateMm, m.skate_tick);
+        fmt::print("  penetration_mm         {:10.4f}  (limit < {}; deepest: {} at tick {})\n", m.penetration_mm,
+                   kMaxPenetrationMm, m.deepest_point.empty() ? "none" : m.deepest_point, m.deepest_tick);
+        fmt::print("  speed_error_pct        {:10.4f}  (limit < {}; {} holds measured)\n", m.speed_error_pct,
+                   kMaxSpeedErrorPct, m.speed_windows);
+        fmt::print("  max_joint_speed_deg_s  {:10.1f}  (limit < {}; {} at tick {})\n", m.max_joint_speed_deg_s, kMaxJointSpeedDegS,
+                   m.fastest_joint, m.fastest_joint_tick);
+        fmt::print("  steps {}  flight_phases {}  final hash {:016x}\n", m.steps, m.flight_phases, m.final_hash);
+        if (!failures.empty()) fmt::print("  LIMITS BROKEN: {}\n", failures);
+    }
+    if (o.check && !failures.empty()) {
+        fmt::print(stderr, "gait-eval: {} on {}: {}\n", o.program, config.terrain_name, failures);
+        return 1;
+    }
+    return 0;
+}
+}  // namespace
+
+void register_gait_eval_command(CLI::App& app, int& exit_code) {
+    auto o = std::make_shared<GaitEvalOptions>();
+    CLI::App* cmd = app.add_subcommand("gait-eval", "Run the gait headless over a stick program on a terrain and print its metrics");
+    cmd->add_option("--terrain", o->terrain, "terrain file, or a built-in name (flat, stairs, slope, rubble); default: the config's");
+    cmd->add_option("--program", o->program, "stick program file, or builtin:NAME")->required();
+    cmd->add_option("--config", o->config_file, "TOML file overriding the defaults")->check(CLI::ExistingFile);
+    cmd->add_option("--feet-csv", o->feet_csv, "write a per-tick CSV of both feet (clearance of each sole point) here");
+    cmd->add_flag("--json", o->json, "print one JSON object");
+    cmd->add_flag("--check", o->check, "exit 1 when a metric breaks its limit");
+    on_parsed(cmd, exit_code, [o] { return gait_eval_command(*o); });
+}
+
+}  // namespace marionette

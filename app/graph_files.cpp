@@ -1,0 +1,38 @@
+#include "app/graph_files.hpp"
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <stdexcept>
+
+#include "app/files.hpp"
+
+namespace marionette {
+
+MotionGraph load_motion_graph_file(const std::string& path) {
+    const std::vector<std::uint8_t> bytes = read_binary_file(path);
+    return deserialize_motion_graph(bytes, path);
+}
+
+void write_binary_file(const std::string& path, const std::vector<std::uint8_t>& bytes) {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error(path + ": cannot create file: " + std::strerror(errno));
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    out.close();
+    if (!out) throw std::runtime_error(path + ": write failed: " + std::strerror(errno));
+}
+
+graph::GraphBuildParams graph_build_params(const SimConfig& c) {
+    graph::GraphBuildParams p;
+    p.analysis_rate_hz = c.graph_analysis_rate_hz;
+    p.window_frames = c.graph_window_frames;
+    p.neighbourhood_frames = c.graph_neighbourhood_frames;
+    p.threshold_percentile = c.graph_threshold_percentile;
+    p.threshold_absolute = c.graph_threshold_absolute;
+    p.bridge_percentile = c.graph_bridge_percentile;
+    p.contact_height = c.graph_contact_height;
+    p.contact_speed = c.graph_contact_speed;
+    return p;
+}
+
+}  // namespace marionette

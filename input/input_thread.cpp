@@ -1,0 +1,198 @@
+#include "input/input_thread.hpp"
+
+#include <unistd.h>
+
+#include <array>
+#include <future>
+#include <memory>
+
+#include "input/evdev/evdev_backend.hpp"
+#include "input/hid/hid_pad.hpp"
+#include "input/hid/hidapi_transport.hpp"
+#include "input/sdl/sdl_backend.hpp"
+
+namespace marionette::input {
+
+namespace {
+constexpr int kBatch = 64;
+
+DeviceFamily family_of(HidFormat f) {
+    switch (f) {
+        case HidFormat::ds4: return DeviceFamily::ds4;
+        case HidFormat::dualsense: return DeviceFamily::dualsense;
+        case HidFormat::switchpro: return DeviceFamily::switchpro;
+        case HidFormat::steamdeck: return DeviceFamily::steamdeck;
+    }
+    return DeviceFamily::evdev;
+}
+}  // namespace
+
+BackendChoice probe_input_backend(const std::string& evdev_dir) {
+    AutoSelectInputs found;
+    for (const HidDeviceInfo& h : enumerate_hid_pads())
+        found.hid.push_back({h.vendor_id, h.product_id, h.interface_number, access(h.path.c_str(), R_OK | W_OK) == 0});
+    for (const EvdevDeviceInfo& e : enumerate_evdev_gamepads(evdev_dir))
+        found.evdev.push_back({e.path, e.vendor_id, e.product_id});
+    if (found.hid.empty() && found.evdev.empty()) {
+        SdlBackend sdl;
+        std::string error;
+        found.sdl_available = sdl.start("", error);
+        found.sdl_joysticks = sdl.joysticks();
+    }
+    return choose_input_backend(found);
+}
+
+bool InputThread::start(InputRing& ring, const InputThreadOptions& options, std::string& error) {
+    stop();
+    options_ = options;
+    if (options.backend == "auto") {
+        const BackendChoice choice = probe_input_backend(options.evdev_dir);
+        kind_ = choice.kind;
+        description_ = choice.reason;
+        if (kind_ == BackendKind::none) {
+            error = choice.reason;
+            return false;
+        }
+    } else {
+        const auto k = backend_from_name(options.backend);
+        if (!k) {
+            error = "--backend " + options.backend + ": expected auto, hidraw, evdev or sdl";
+            return false;
+        }
+        kind_ = *k;
+        description_ = std::string(backend_name(kind_)) + ": chosen on the command line";
+    }
+    stop_requested_ = false;
+    std::promise<std::string> started;
+    std::future<std::string> result = started.get_future();
+    thread_ = std::thread([this, &ring, &started] {
+        // Each runner opens its backend, reports success or failure through
+        // `started` (exactly once), then loops until stop().
+        switch (kind_) {
+            case BackendKind::evdev: {
+                EvdevBackend backend;
+                std::string err;
+                const bool ok = options_.device_path.empty() ? backend.watch_directory(options_.evdev_dir, err)
+                                                             : backend.open_device(options_.device_path, err);
+                started.set_value(ok ? "" : err);
+                if (!ok) return;
+                running_ = true;
+                backend.set_raw(options_.raw);
+                InputRingWriter<InputRing> writer(ring);
+                std::array<InputSample, kBatch> batch{};
+                const FamilyCalibration& cal = options_.config.family(DeviceFamily::evdev);
+                while (!stop_requested_.load(std::memory_order_relaxed)) {
+                    const int n = backend.poll(batch, 20);
+                    for (int i = 0; i < n; ++i) {
+                        InputSample& s = batch[static_cast<std::size_t>(i)];
+                        apply_calibration(cal, options_.raw, s);
+                        if (writer.push(to_timed_input(s))) samples_.fetch_add(1, std::memory_order_relaxed);
+                    }
+                    connected_.store(backend.connected() > 0, std::memory_order_release);
+                    connects_.store(backend.connects(), std::memory_order_relaxed);
+                    disconnects_.store(backend.disconnects(), std::memory_order_relaxed);
+                    syn_dropped_.store(backend.syn_dropped(), std::memory_order_relaxed);
+                    ring_dropped_.store(writer.dropped(), std::memory_order_relaxed);
+                }
+                break;
+            }
+            case BackendKind::hidraw: {
+                std::string path = options_.device_path;
+                HidFormat format = HidFormat::ds4;
+                const std::vector<HidDeviceInfo> pads = enumerate_hid_pads();
+                bool known = false;
+                for (const HidDeviceInfo& p : pads)
+                    if (path.empty() || p.path == path) {
+                        path = p.path;
+                        format = p.format;
+                        known = true;
+                        break;
+                    }
+                std::unique_ptr<HidTransport> transport = known ? open_hidapi_transport(path) : nullptr;
+                if (!transport) {
+                    started.set_value(known ? path + ": cannot open the hidraw node (permissions? see docs/input.md)"
+                                            : "no supported HID pad found");
+                    return;
+                }
+                HidPad pad(*transport, format);
+                if (!pad.initialise(200)) {
+                    started.set_value(path + ": the pad did not accept its start-up reports");
+                    return;
+                }
+                started.set_value("");
+                running_ = true;
+                connected_ = true;
+                connects_ = 1;
+                InputRingWriter<InputRing> writer(ring);
+                const FamilyCalibration& cal = options_.config.family(family_of(format));
+                InputSample s;
+                while (!stop_requested_.load(std::memory_order_relaxed)) {
+                    const HidPad::Result r = pad.read(s, 1);
+                    if (r == HidPad::Result::sample) {
+                        s.t_ns = monotonic_now_ns();
+                        apply_calibration(cal, options_.raw, s);
+                        if (writer.push(to_timed_input(s))) samples_.fetch_add(1, std::memory_order_relaxed);
+                        ring_dropped_.store(writer.dropped(), std::memory_order_relaxed);
+                    } else if (r == HidPad::Result::rejected) {
+                        rejected_.store(pad.counters().rejected(), std::memory_order_relaxed);
+                    } else if (r == HidPad::Result::disconnected) {
+                        connected_ = false;
+                        disconnects_.fetch_add(1);
+                        break;  // the pipeline sees device_connected() == false
+                    }
+                }
+                break;
+            }
+            case BackendKind::sdl: {
+                SdlBackend sdl;
+                std::string err;
+                const bool ok = sdl.start(options_.config.sdl_mapping_file, err);
+                started.set_value(ok ? "" : err);
+                if (!ok) return;
+                running_ = true;
+                InputRingWriter<InputRing> writer(ring);
+                std::array<InputSample, 1> batch{};
+                const FamilyCalibration& cal = options_.config.family(DeviceFamily::sdl);
+                while (!stop_requested_.load(std::memory_order_relaxed)) {
+                    if (sdl.poll(batch, 5) == 1) {
+                        apply_calibration(cal, options_.raw, batch[0]);
+                        if (writer.push(to_timed_input(batch[0]))) samples_.fetch_add(1, std::memory_order_relaxed);
+                    }
+                    connected_.store(sdl.connected(), std::memory_order_release);
+                    connects_.store(sdl.connects(), std::memory_order_relaxed);
+                    disconnects_.store(sdl.disconnects(), std::memory_order_relaxed);
+                    ring_dropped_.store(writer.dropped(), std::memory_order_relaxed);
+                }
+                break;
+            }
+            case BackendKind::none: started.set_value("no backend"); return;
+        }
+        running_ = false;
+    });
+    error = result.get();
+    if (!error.empty()) {
+        thread_.join();
+        return false;
+    }
+    return true;
+}
+
+void InputThread::stop() {
+    stop_requested_ = true;
+    if (thread_.joinable()) thread_.join();
+    running_ = false;
+    connected_ = false;
+}
+
+InputThreadStats InputThread::stats() const {
+    InputThreadStats s;
+    s.samples = samples_.load();
+    s.ring_dropped = ring_dropped_.load();
+    s.rejected_reports = rejected_.load();
+    s.connects = connects_.load();
+    s.disconnects = disconnects_.load();
+    s.syn_dropped = syn_dropped_.load();
+    return s;
+}
+
+}  // namespace marionette::input

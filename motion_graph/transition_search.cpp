@@ -1,0 +1,415 @@
+#include "motion_graph/transition_search.hpp"
+
+#include <cblas.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <thread>
+
+namespace marionette::graph {
+
+namespace {
+
+int thread_count(int requested) {
+    if (requested > 0) return requested;
+    const unsigned hw = std::thread::hardware_concurrency();
+    return hw > 0 ? static_cast<int>(hw) : 1;
+}
+
+// D from the window sums (see FrameFeatures): Ã and B̃ are the alignment's
+// centred dot and cross terms; the closed-form minimum over the rotation is
+// S_A + S_B − 2·Y − 2·sqrt(Ã² + B̃²).
+inline double distance_from_sums(const FrameFeatures& f, std::int32_t i, std::int32_t g, double sum_dot,
+                                 double sum_cross, double sum_y) {
+    const double k = f.window;
+    const size_t ui = static_cast<size_t>(i), ug = static_cast<size_t>(g);
+    const double ax = f.window_cx[ui], az = f.window_cz[ui], bx = f.window_cx[ug], bz = f.window_cz[ug];
+    const double dot = sum_dot - f.weight * (ax * bx + az * bz) / k;
+    const double cross = sum_cross - f.weight * (ax * bz - az * bx) / k;
+    const double d = f.window_spread[ui] + f.window_spread[ug] - 2.0 * sum_y - 2.0 * std::sqrt(dot * dot + cross * cross);
+    return d > 0.0 ? d / (f.weight * k) : 0.0;
+}
+
+// +inf, −1 (near-diagonal) or 0 (a pair to evaluate).
+inline float pair_status(const FrameFeatures& f, std::int32_t i, std::int32_t j) {
+    if (i < 0 || j < 0 || i >= f.frames || j >= f.frames) return kPairInvalid;
+    if (!f.start_ok[static_cast<size_t>(i)] || !f.end_ok[static_cast<size_t>(j)]) return kPairInvalid;
+    const std::int32_t g = j - f.window + 1;
+    if (f.clip_of[static_cast<size_t>(i)] == f.clip_of[static_cast<size_t>(g)] && std::abs(i - g) <= f.window)
+        return kPairExcluded;
+    return 0.0f;
+}
+
+// The local-minimum rule shared by the tiled and the reference search: below the
+// threshold, no excluded cell in the neighbourhood, strictly below every earlier
+// neighbour (raster order) and not above any later one, so plateaus give one minimum.
+template <typename Lookup>
+bool is_local_minimum(float v, std::int32_t i, std::int32_t j, int h, double threshold, Lookup&& at) {
+    if (v < 0.0f || v >= kPairInvalid || v > threshold) return false;
+    for (int di = -h; di <= h; ++di)
+        for (int dj = -h; dj <= h; ++dj) {
+            if (di == 0 && dj == 0) continue;
+            const float u = at(i + di, j + dj);
+            if (u < 0.0f || u < v) return false;
+            if (u == v && (di < 0 || (di == 0 && dj < 0))) return false;
+        }
+    return true;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::int32_t, std::int32_t>> local_minima(std::span<const float> m, std::int32_t rows,
+                                                               std::int32_t cols, int h, double threshold) {
+    const auto at = [&](std::int32_t i, std::int32_t j) -> float {
+        if (i < 0 || j < 0 || i >= rows || j >= cols) return kPairInvalid;
+        return m[static_cast<size_t>(i) * static_cast<size_t>(cols) + static_cast<size_t>(j)];
+    };
+    std::vector<std::pair<std::int32_t, std::int32_t>> out;
+    for (std::int32_t i = 0; i < rows; ++i)
+        for (std::int32_t j = 0; j < cols; ++j)
+            if (is_local_minimum(at(i, j), i, j, h, threshold, at)) out.push_back({i, j});
+    return out;
+}
+
+std::vector<vec3> database_positions(const ClipDatabase& db) {
+    const size_t joints = static_cast<size_t>(db.skeleton.joint_count());
+    std::vector<vec3> out(static_cast<size_t>(db.frame_count()) * joints);
+    std::vector<quat> model_rotations(joints);
+    size_t frame = 0;
+    for (const Clip& clip : db.clips)
+        for (int f = 0; f < clip.frame_count; ++f, ++frame) {
+            LocalToModelJob fk{db.skeleton.parents, std::span<const quat>(clip.frame_rotations(f), joints),
+                               std::span<const vec3>(clip.frame_translations(f), joints), model_rotations,
+                               std::span<vec3>(out.data() + frame * joints, joints)};
+            fk.run();
+        }
+    return out;
+}
+
+FrameFeatures compute_frame_features(const ClipDatabase& db, std::span<const vec3> positions, int window, double scale) {
+    FrameFeatures f;
+    f.frames = static_cast<std::int32_t>(db.frame_count());
+    f.joints = db.skeleton.joint_count();
+    f.window = window;
+    const size_t n = static_cast<size_t>(f.frames), J = static_cast<size_t>(f.joints);
+    const double inv_scale = 1.0 / scale;
+    std::vector<double> sqrt_w(J);
+    for (size_t j = 0; j < J; ++j) {
+        f.weight += db.joint_weights[j];
+        sqrt_w[j] = std::sqrt(static_cast<double>(db.joint_weights[j]));
+    }
+    f.xz.resize(n * 2 * J);
+    f.zx.resize(n * 2 * J);
+    f.y.resize(n * J);
+    f.cx.resize(n);
+    f.cz.resize(n);
+    std::vector<double> spread(n);
+    f.clip_of.resize(n);
+    size_t at = 0;
+    for (size_t c = 0; c < db.clips.size(); ++c)
+        for (int i = 0; i < db.clips[c].frame_count; ++i) f.clip_of[at++] = static_cast<std::int32_t>(c);
+    for (size_t fr = 0; fr < n; ++fr) {
+        const vec3* p = positions.data() + fr * J;
+        double cx = 0.0, cz = 0.0;
+        for (size_t j = 0; j < J; ++j) {
+            cx += db.joint_weights[j] * (p[j].x * inv_scale);
+            cz += db.joint_weights[j] * (p[j].z * inv_scale);
+        }
+        cx /= f.weight;
+        cz /= f.weight;
+        f.cx[fr] = cx;
+        f.cz[fr] = cz;
+        double s = 0.0;
+        for (size_t j = 0; j < J; ++j) {
+            const double qx = sqrt_w[j] * (p[j].x * inv_scale - cx), qz = sqrt_w[j] * (p[j].z * inv_scale - cz);
+            const double qy = sqrt_w[j] * (p[j].y * inv_scale);
+            f.xz[fr * 2 * J + j] = static_cast<float>(qx);
+            f.xz[fr * 2 * J + J + j] = static_cast<float>(qz);
+            f.zx[fr * 2 * J + j] = static_cast<float>(qz);
+            f.zx[fr * 2 * J + J + j] = static_cast<float>(-qx);
+            f.y[fr * J + j] = static_cast<float>(qy);
+            s += qx * qx + qz * qz + qy * qy;
+        }
+        spread[fr] = s;
+    }
+    const size_t k = static_cast<size_t>(window);
+    f.start_ok.assign(n, 0);
+    f.end_ok.assign(n, 0);
+    f.window_spread.assign(n, 0.0);
+    f.window_cx.assign(n, 0.0);
+    f.window_cz.assign(n, 0.0);
+    for (size_t s = 0; s + k <= n; ++s) {
+        if (f.clip_of[s] != f.clip_of[s + k - 1]) continue;
+        f.start_ok[s] = 1;
+        f.end_ok[s + k - 1] = 1;
+        double sum = 0.0, sx = 0.0, sz = 0.0, cc = 0.0;
+        for (size_t t = 0; t < k; ++t) {
+            sum += spread[s + t];
+            sx += f.cx[s + t];
+            sz += f.cz[s + t];
+            cc += f.cx[s + t] * f.cx[s + t] + f.cz[s + t] * f.cz[s + t];
+        }
+        f.window_cx[s] = sx;
+        f.window_cz[s] = sz;
+        f.window_spread[s] = sum + f.weight * (cc - (sx * sx + sz * sz) / window);
+    }
+    return f;
+}
+
+double feature_pair_distance(const FrameFeatures& f, std::int32_t i, std::int32_t j) {
+    const float status = pair_status(f, i, j);
+    if (status != 0.0f) return status;
+    const std::int32_t g = j - f.window + 1;
+    const size_t J = static_cast<size_t>(f.joints);
+    double sd = 0.0, sc = 0.0, sy = 0.0;
+    for (int t = 0; t < f.window; ++t) {
+        const size_t a = static_cast<size_t>(i + t), b = static_cast<size_t>(g + t);
+        for (size_t q = 0; q < 2 * J; ++q) {
+            sd += static_cast<double>(f.xz[a * 2 * J + q]) * f.xz[b * 2 * J + q];
+            sc += static_cast<double>(f.xz[a * 2 * J + q]) * f.zx[b * 2 * J + q];
+        }
+        for (size_t q = 0; q < J; ++q) sy += static_cast<double>(f.y[a * J + q]) * f.y[b * J + q];
+        sd += f.weight * (f.cx[a] * f.cx[b] + f.cz[a] * f.cz[b]);
+        sc += f.weight * (f.cx[a] * f.cz[b] - f.cz[a] * f.cx[b]);
+    }
+    return distance_from_sums(f, i, g, sd, sc, sy);
+}
+
+double reference_pair_distance(const ClipDatabase& db, std::span<const vec3> positions, int window, double scale,
+                               std::int32_t i, std::int32_t j, PlanarTransform* align) {
+    const size_t J = static_cast<size_t>(db.skeleton.joint_count());
+    const std::int32_t g = j - window + 1;
+    PlanarCrossSums sums;
+    for (int t = 0; t < window; ++t)
+        for (size_t q = 0; q < J; ++q)
+            accumulate_planar_sums(sums, positions[static_cast<size_t>(i + t) * J + q],
+                                   positions[static_cast<size_t>(g + t) * J + q], db.joint_weights[q]);
+    const PlanarTransform t = align_from_sums(sums);
+    if (align) *align = t;
+    double total = 0.0;
+    for (int s = 0; s < window; ++s) {
+        const std::span<const vec3> a(positions.data() + static_cast<size_t>(i + s) * J, J);
+        const std::span<const vec3> b(positions.data() + static_cast<size_t>(g + s) * J, J);
+        total += planar_cloud_distance(a, b, db.joint_weights, t);
+    }
+    double weight = 0.0;
+    for (float w : db.joint_weights) weight += w;
+    return total / (weight * window * scale * scale);
+}
+
+std::vector<double> distance_percentiles(const FrameFeatures& f, const std::vector<double>& percentiles,
+                                         std::int64_t max_samples) {
+    std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
+    std::int64_t starts = 0, ends = 0;
+    for (std::int32_t i = 0; i < f.frames; ++i) {
+        starts += f.start_ok[static_cast<size_t>(i)];
+        ends += f.end_ok[static_cast<size_t>(i)];
+    }
+    if (starts * ends <= max_samples) {
+        for (std::int32_t i = 0; i < f.frames; ++i)
+            for (std::int32_t j = 0; j < f.frames; ++j)
+                if (pair_status(f, i, j) == 0.0f) pairs.push_back({i, j});
+    } else {
+        std::uint64_t state = 0x9e3779b97f4a7c15ull;  // fixed seed: the same sample every build
+        const auto next = [&state](std::int32_t n) {
+            state = state * 6364136223846793005ull + 1442695040888963407ull;
+            return static_cast<std::int32_t>((state >> 33) % static_cast<std::uint64_t>(n));
+        };
+        for (std::int64_t tries = 0; static_cast<std::int64_t>(pairs.size()) < max_samples && tries < 20 * max_samples; ++tries) {
+            const std::int32_t i = next(f.frames), j = next(f.frames);
+            if (pair_status(f, i, j) == 0.0f) pairs.push_back({i, j});
+        }
+    }
+    if (pairs.empty()) return std::vector<double>(percentiles.size(), 0.0);
+    std::vector<double> d(pairs.size());
+    const int threads = thread_count(0);
+    std::vector<std::thread> workers;
+    for (int t = 0; t < threads; ++t)
+        workers.emplace_back([&, t] {
+            for (size_t p = static_cast<size_t>(t); p < pairs.size(); p += static_cast<size_t>(threads))
+                d[p] = feature_pair_distance(f, pairs[p].first, pairs[p].second);
+        });
+    for (std::thread& w : workers) w.join();
+    std::sort(d.begin(), d.end());
+    std::vector<double> out;
+    for (double p : percentiles)
+        out.push_back(d[static_cast<size_t>(std::clamp(p, 0.0, 100.0) / 100.0 * static_cast<double>(d.size() - 1))]);
+    return out;
+}
+
+namespace {
+
+struct TileScratch {
+    std::vector<float> ca, cb, cy;        // per-frame cross terms of the tile
+    std::vector<double> pa, pb, py;       // their prefix sums along diagonals
+    std::vector<float> d;                 // distances of the tile plus halo
+    std::vector<TransitionCandidate> found;
+    std::vector<float> plot;
+    std::int64_t evaluations = 0;
+};
+
+void run_tile(const FrameFeatures& f, const CandidateSearchOptions& o, std::int32_t i0, std::int32_t i1,
+              std::int32_t j0, std::int32_t j1, TileScratch& s) {
+    const std::int32_t k = f.window, h = o.neighbourhood, N = f.frames;
+    const std::int32_t i_end = N - k + 1, j_begin = k - 1;  // valid i < i_end, j ≥ j_begin
+    const std::int32_t ci0 = std::max(i0, 0), ci1 = std::min(i1, i_end);
+    const std::int32_t cj0 = std::max(j0, j_begin), cj1 = std::min(j1, N);
+    if (ci0 >= ci1 || cj0 >= cj1) return;
+    const std::int32_t ei0 = std::max(ci0 - h, 0), ei1 = std::min(ci1 + h, i_end);
+    const std::int32_t ej0 = std::max(cj0 - h, j_begin), ej1 = std::min(cj1 + h, N);
+    const std::int32_t nr = ei1 - ei0 + k - 1, nc = ej1 - ej0 + k - 1;
+    const std::int32_t row0 = ei0, col0 = ej0 - k + 1;
+    const int J = f.joints;
+    const size_t cells = static_cast<size_t>(nr) * static_cast<size_t>(nc);
+    s.ca.resize(cells);
+    s.cb.resize(cells);
+    s.cy.resize(cells);
+    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, nr, nc, 2 * J, 1.0f, f.xz.data() + static_cast<size_t>(row0) * 2 * J,
+                2 * J, f.xz.data() + static_cast<size_t>(col0) * 2 * J, 2 * J, 0.0f, s.ca.data(), nc);
+    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, nr, nc, 2 * J, 1.0f, f.xz.data() + static_cast<size_t>(row0) * 2 * J,
+                2 * J, f.zx.data() + static_cast<size_t>(col0) * 2 * J, 2 * J, 0.0f, s.cb.data(), nc);
+    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, nr, nc, J, 1.0f, f.y.data() + static_cast<size_t>(row0) * J, J,
+                f.y.data() + static_cast<size_t>(col0) * J, J, 0.0f, s.cy.data(), nc);
+
+    // Prefix sums along diagonals, with a zero border row and column:
+    // P[r+1][c+1] = v(r, c) + P[r][c], so a k-cell diagonal run is P[r+k][c+k] − P[r][c].
+    const size_t pw = static_cast<size_t>(nc) + 1;
+    const size_t pcells = (static_cast<size_t>(nr) + 1) * pw;
+    s.pa.resize(pcells);
+    s.pb.resize(pcells);
+    s.py.resize(pcells);
+    std::fill(s.pa.begin(), s.pa.begin() + static_cast<std::ptrdiff_t>(pw), 0.0);
+    std::fill(s.pb.begin(), s.pb.begin() + static_cast<std::ptrdiff_t>(pw), 0.0);
+    std::fill(s.py.begin(), s.py.begin() + static_cast<std::ptrdiff_t>(pw), 0.0);
+    const double W = f.weight;
+    for (std::int32_t r = 0; r < nr; ++r) {
+        const size_t up = static_cast<size_t>(r) * pw, row = up + pw;
+        s.pa[row] = s.pb[row] = s.py[row] = 0.0;
+        const double rx = f.cx[static_cast<size_t>(row0 + r)], rz = f.cz[static_cast<size_t>(row0 + r)];
+        const size_t cbase = static_cast<size_t>(r) * static_cast<size_t>(nc);
+        for (std::int32_t c = 0; c < nc; ++c) {
+            const size_t uc = static_cast<size_t>(c);
+            const double gx = f.cx[static_cast<size_t>(col0 + c)], gz = f.cz[static_cast<size_t>(col0 + c)];
+            s.pa[row + uc + 1] = s.ca[cbase + uc] + W * (rx * gx + rz * gz) + s.pa[up + uc];
+            s.pb[row + uc + 1] = s.cb[cbase + uc] + W * (rx * gz - rz * gx) + s.pb[up + uc];
+            s.py[row + uc + 1] = s.cy[cbase + uc] + s.py[up + uc];
+        }
+    }
+
+    const std::int32_t dr = ei1 - ei0, dc = ej1 - ej0;
+    s.d.resize(static_cast<size_t>(dr) * static_cast<size_t>(dc));
+    for (std::int32_t i = ei0; i < ei1; ++i)
+        for (std::int32_t j = ej0; j < ej1; ++j) {
+            float v = pair_status(f, i, j);
+            if (v == 0.0f) {
+                const size_t r = static_cast<size_t>(i - ei0), c = static_cast<size_t>(j - ej0), kk = static_cast<size_t>(k);
+                const size_t hi = (r + kk) * pw + c + kk, lo = r * pw + c;
+                v = static_cast<float>(distance_from_sums(f, i, j - k + 1, s.pa[hi] - s.pa[lo], s.pb[hi] - s.pb[lo],
+                                                          s.py[hi] - s.py[lo]));
+            }
+            s.d[static_cast<size_t>(i - ei0) * static_cast<size_t>(dc) + static_cast<size_t>(j - ej0)] = v;
+        }
+
+    std::map<std::pair<std::int32_t, std::int32_t>, std::vector<TransitionCandidate>> bridges;
+    const auto at = [&](std::int32_t i, std::int32_t j) -> float {
+        if (i < ei0 || i >= ei1 || j < ej0 || j >= ej1) return kPairInvalid;  // outside the valid range
+        return s.d[static_cast<size_t>(i - ei0) * static_cast<size_t>(dc) + static_cast<size_t>(j - ej0)];
+    };
+    for (std::int32_t i = ci0; i < ci1; ++i)
+        for (std::int32_t j = cj0; j < cj1; ++j) {
+            const float v = at(i, j);
+            if (v >= 0.0f && v < kPairInvalid) ++s.evaluations;
+            if (o.plot && v >= 0.0f && v < kPairInvalid) {
+                const size_t px = static_cast<size_t>(static_cast<std::int64_t>(i) * o.plot_size / N);
+                const size_t py = static_cast<size_t>(static_cast<std::int64_t>(j) * o.plot_size / N);
+                float& pixel = s.plot[px * static_cast<size_t>(o.plot_size) + py];
+                pixel = std::min(pixel, v);
+            }
+            if (!is_local_minimum(v, i, j, h, std::max(o.threshold, o.bridge_threshold), at)) continue;
+            if (v <= o.threshold) {
+                s.found.push_back({i, j, v});
+                continue;
+            }
+            auto& best = bridges[{f.clip_of[static_cast<size_t>(i)], f.clip_of[static_cast<size_t>(j)]}];
+            best.push_back({i, j, v});
+            std::sort(best.begin(), best.end(),
+                      [](const TransitionCandidate& a, const TransitionCandidate& b) { return a.distance < b.distance; });
+            if (best.size() > static_cast<size_t>(o.bridges_per_clip_pair)) best.pop_back();
+        }
+    for (const auto& [clips, best] : bridges) s.found.insert(s.found.end(), best.begin(), best.end());
+}
+
+}  // namespace
+
+CandidateSearchResult find_transition_candidates(const FrameFeatures& f, const CandidateSearchOptions& o) {
+    openblas_set_num_threads(1);  // parallel over tiles instead: one sgemm per thread at a time
+    const std::int32_t T = std::max(16, o.tile);
+    const std::int32_t tiles_per_side = (f.frames + T - 1) / T;
+    const std::int64_t tile_count = static_cast<std::int64_t>(tiles_per_side) * tiles_per_side;
+    const int threads = static_cast<int>(std::min<std::int64_t>(thread_count(o.threads), std::max<std::int64_t>(tile_count, 1)));
+    std::vector<TileScratch> scratch(static_cast<size_t>(threads));
+    if (o.plot)
+        for (TileScratch& s : scratch)
+            s.plot.assign(static_cast<size_t>(o.plot_size) * static_cast<size_t>(o.plot_size), kPairInvalid);
+    std::atomic<std::int64_t> next{0}, done{0};
+    const auto work = [&](int t) {
+        for (std::int64_t tile = next++; tile < tile_count; tile = next++) {
+            const std::int32_t ti = static_cast<std::int32_t>(tile / tiles_per_side);
+            const std::int32_t tj = static_cast<std::int32_t>(tile % tiles_per_side);
+            run_tile(f, o, ti * T, (ti + 1) * T, tj * T, (tj + 1) * T, scratch[static_cast<size_t>(t)]);
+            ++done;
+            if (t == 0 && o.progress) o.progress(static_cast<double>(done.load()) / static_cast<double>(tile_count));
+        }
+    };
+    std::vector<std::thread> workers;
+    for (int t = 1; t < threads; ++t) workers.emplace_back(work, t);
+    work(0);
+    for (std::thread& w : workers) w.join();
+    if (o.progress) o.progress(1.0);
+
+    CandidateSearchResult out;
+    for (TileScratch& s : scratch) {
+        out.candidates.insert(out.candidates.end(), s.found.begin(), s.found.end());
+        out.pair_evaluations += s.evaluations;
+    }
+    std::sort(out.candidates.begin(), out.candidates.end(), [](const TransitionCandidate& a, const TransitionCandidate& b) {
+        return a.from_frame != b.from_frame ? a.from_frame < b.from_frame : a.to_frame < b.to_frame;
+    });
+    if (o.plot) {
+        o.plot->assign(static_cast<size_t>(o.plot_size) * static_cast<size_t>(o.plot_size), kPairInvalid);
+        for (const TileScratch& s : scratch)
+            for (size_t p = 0; p < o.plot->size(); ++p) (*o.plot)[p] = std::min((*o.plot)[p], s.plot[p]);
+    }
+    return out;
+}
+
+CandidateSearchResult find_transition_candidates_reference(const ClipDatabase& db, std::span<const vec3> positions,
+                                                           const FrameFeatures& f, double scale,
+                                                           const CandidateSearchOptions& o) {
+    const std::int32_t N = f.frames;
+    std::vector<float> d(static_cast<size_t>(N) * static_cast<size_t>(N));
+    CandidateSearchResult out;
+    for (std::int32_t i = 0; i < N; ++i)
+        for (std::int32_t j = 0; j < N; ++j) {
+            float v = pair_status(f, i, j);
+            if (v == 0.0f) {
+                v = static_cast<float>(reference_pair_distance(db, positions, f.window, scale, i, j));
+                ++out.pair_evaluations;
+            }
+            d[static_cast<size_t>(i) * static_cast<size_t>(N) + static_cast<size_t>(j)] = v;
+        }
+    const auto at = [&](std::int32_t i, std::int32_t j) -> float {
+        if (i < 0 || j < 0 || i >= N || j >= N) return kPairInvalid;
+        return d[static_cast<size_t>(i) * static_cast<size_t>(N) + static_cast<size_t>(j)];
+    };
+    for (std::int32_t i = 0; i < N; ++i)
+        for (std::int32_t j = 0; j < N; ++j)
+            if (is_local_minimum(at(i, j), i, j, o.neighbourhood, o.threshold, at))
+                out.candidates.push_back({i, j, at(i, j)});  // regular candidates only
+    return out;
+}
+
+}  // namespace marionette::graph
