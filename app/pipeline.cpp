@@ -15,12 +15,16 @@
 #include "app/files.hpp"
 #include "app/realtime.hpp"
 #include "app/replay.hpp"
+#include "input/input_thread.hpp"
 #include "render_es/interpolate.hpp"
 #include "render_es/view.hpp"
 #include "runtime/det_math.hpp"
+#include "runtime/import_error.hpp"
 #include "runtime/fixed_step.hpp"
 
 namespace marionette {
+
+static_assert(std::is_same_v<InputRing, input::InputRing>, "the device input thread pushes into the pipeline's ring");
 
 // ---------------------------------------------------------------- simulation
 
@@ -498,6 +502,7 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
     RenderInputs render_inputs{&o.display, &loop->simulation().skeleton(), &loop->simulation().terrain(),
                                config.ankle_height, config.tick_rate_hz};
     std::thread sim_thread, in_thread, gfx_thread;
+    auto device = std::make_unique<input::InputThread>();  // stopped (joined) by its destructor
     ThreadGuard guard{{&sim_thread, &in_thread, &gfx_thread}, sh};
     std::int64_t wall_start = 0;
     try {
@@ -513,9 +518,17 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
         result.display_description = display.description;
         wall_start = monotonic_ns();
         const std::int64_t t0 = o.virtual_time ? 0 : wall_start + 20'000'000;  // let the threads start first
+        // The input thread before the simulation thread: a device backend that
+        // cannot open its pad fails here, before any tick runs or is recorded.
+        if (o.device) {
+            std::string error;
+            if (!device->start(sh.input_ring, *o.device, error)) throw ImportError("--input " + o.device->backend, 0, error);
+            result.input_description = device->backend_description();
+        } else {
+            in_thread = std::thread(input_thread, std::ref(sh), std::cref(o.script), t0, o.virtual_time);
+        }
         sim_thread = std::thread(simulation_thread, std::ref(sh), std::ref(*loop), o.total_ticks, t0, o.virtual_time,
                                  !o.script.stamp_when_read, std::ref(sim_result));
-        in_thread = std::thread(input_thread, std::ref(sh), std::cref(o.script), t0, o.virtual_time);
     } catch (...) {
         pthread_sigmask(SIG_SETMASK, &previous_mask, nullptr);
         throw;
@@ -524,7 +537,7 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
     // Virtual time waits by spinning: never under SCHED_FIFO, where a spinning
     // thread would starve the writer it waits for.
     const bool fifo = !o.virtual_time;
-    note_failure(apply_thread_settings(in_thread, "mario-input", fifo ? config.input_priority : 0, config.input_cpu));
+    note_failure(apply_thread_settings(o.device ? device->thread() : in_thread, "mario-input", fifo ? config.input_priority : 0, config.input_cpu));
     note_failure(apply_thread_settings(sim_thread, "mario-sim", fifo ? config.simulation_priority : 0, config.simulation_cpu));
     note_failure(apply_thread_settings(gfx_thread, "mario-render", fifo ? config.render_priority : 0, config.render_cpu));
     if (!realtime_failed.empty()) {
@@ -610,6 +623,12 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
             result.stopped = true;
             sh.stop.store(true);
         }
+        if (o.device) {
+            // The backend keeps its own counters; the status line reads these.
+            const input::InputThreadStats st = device->stats();
+            sh.counters.samples_pushed.store(st.samples, std::memory_order_relaxed);
+            sh.counters.samples_dropped.store(st.ring_dropped, std::memory_order_relaxed);
+        }
         if (!result.display_closed && display.closed.load(std::memory_order_acquire)) {
             result.display_closed = true;  // closing the window ends the run normally
             sh.stop.store(true);
@@ -627,7 +646,14 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
         }
     }
     sh.stop.store(true);
-    for (std::thread* t : guard.threads) t->join();
+    if (o.device) {
+        const input::InputThreadStats st = device->stats();
+        sh.counters.samples_pushed.store(st.samples);
+        sh.counters.samples_dropped.store(st.ring_dropped);
+        device->stop();
+    }
+    for (std::thread* t : guard.threads)
+        if (t->joinable()) t->join();
     while (sh.records.try_pop(record)) handle(record);
     if (log) log->close();
     if (trace) {

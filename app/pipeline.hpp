@@ -195,9 +195,16 @@ struct DisplayOptions {
     render::RenderSettings settings;
 };
 
+namespace input {
+struct InputThreadOptions;
+}
+
 struct PipelineOptions {
     SimConfig config;
     InputScript script;
+    // A real controller (input/input_thread.hpp) instead of the script: its own
+    // thread pushes into the input ring; the run lasts until stopped.
+    const input::InputThreadOptions* device = nullptr;
     std::vector<ScheduledConfigChange> scheduled_changes;
     std::uint64_t total_ticks = 0;
     // No clock: ticks run as fast as the input thread provides samples, each tick
@@ -240,6 +247,7 @@ struct PipelineResult {
     std::string realtime_warning;       // what the [realtime] settings could not do
     bool display_closed = false;        // the window was closed (ends the run)
     std::string display_description;    // the GL platform, when one was used
+    std::string input_description;      // the device backend, when one was used
 };
 
 // Runs the whole pipeline until total_ticks have run, a stop is requested or the

@@ -9,6 +9,9 @@
 namespace marionette {
 
 std::string apply_thread_settings(std::thread& thread, const char* name, int priority, int cpu) {
+    // A thread that was never started (no script input thread when a device
+    // backend reads the pad) has no pthread: naming handle 0 would crash.
+    if (!thread.joinable()) return {};
     const pthread_t handle = thread.native_handle();
     pthread_setname_np(handle, name);  // best effort: only for tools like top and gdb
     std::string failed;

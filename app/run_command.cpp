@@ -16,7 +16,12 @@
 #include "app/json.hpp"
 #include "app/pipeline.hpp"
 #include "app/program_source.hpp"
+#include "app/embedded.hpp"
 #include "app/render_config.hpp"
+#include "input/evdev/evdev_backend.hpp"
+#include "input/hid/hidapi_transport.hpp"
+#include "input/input_thread.hpp"
+#include "input/sdl/sdl_backend.hpp"
 #include "app/replay.hpp"
 
 namespace marionette {
@@ -60,6 +65,32 @@ void write_stats_json(const std::string& path, const RunOptions& o, const SimCon
     write_text_file(path, text);
 }
 
+// Virtual time waits for the input thread's watermark, which only a script
+// provides: a pad's samples arrive in real time, so --fast would never tick.
+[[noreturn]] void throw_fast_needs_script() {
+    throw ImportError("--fast", 0,
+                      "needs a simulated or recorded input (sim:PROGRAM or log:FILE): a real controller runs in real "
+                      "time");
+}
+
+// Why the backend named on the command line has no pad to read (empty: it has
+// one). Checked before the run starts so the error is immediate and exits 2.
+std::string missing_pad(const std::string& backend, const std::string& evdev_dir) {
+    if (backend == "evdev") {
+        if (input::enumerate_evdev_gamepads(evdev_dir).empty())
+            return "no gamepad under " + evdev_dir + " (is it plugged in and readable? see `marionette input list`)";
+    } else if (backend == "hidraw") {
+        if (input::enumerate_hid_pads().empty())
+            return "no supported HID pad found (see `marionette input list`)";
+    } else if (backend == "sdl") {
+        input::SdlBackend sdl;
+        std::string error;
+        if (!sdl.start("", error)) return "SDL2 cannot start: " + error;
+        if (sdl.joysticks() == 0) return "SDL2 sees no joystick";
+    }
+    return {};
+}
+
 }  // namespace
 
 int run_command(const RunOptions& o) {
@@ -67,19 +98,38 @@ int run_command(const RunOptions& o) {
     PipelineOptions p;
     std::string source;
     std::string input = o.input;
+    input::InputThreadOptions device;
+    bool use_device = false;
     if (input == "auto") {
-        // No device backend is built in yet (input/ lands with its own issue), so
-        // auto means "no controller found": the simulated controller plays the demo.
-        input = "sim:builtin:demo";
+        // A controller if one is there (input/auto_select.hpp), else the
+        // simulated controller plays the demo.
+        const input::BackendChoice choice = input::probe_input_backend(device.evdev_dir);
+        if (choice.kind == input::BackendKind::none) {
+            fmt::print("marionette: no controller found ({}); the simulated controller plays the demo\n", choice.reason);
+            input = "sim:builtin:demo";
+        } else {
+            device.backend = "auto";
+            use_device = true;
+        }
+    } else if (input == "evdev" || input == "hidapi" || input == "sdl") {
+        device.backend = input == "hidapi" ? "hidraw" : input;
+        use_device = true;
+        if (o.fast) throw_fast_needs_script();
+        // Asked for by name: no pad is an error now, not a run that idles forever.
+        if (const std::string missing = missing_pad(device.backend, device.evdev_dir); !missing.empty())
+            throw ImportError("--input " + input, 0, missing);
     }
-    if (input == "evdev" || input == "hidapi" || input == "sdl")
-        throw ImportError("--input " + input, 0,
-                          "not available in this build: the device backends have not landed yet "
-                          "(use --input sim:PROGRAM or --input log:FILE)");
+    if (use_device && o.fast) throw_fast_needs_script();
     if (!o.unplug.empty() && input.rfind("sim:", 0) != 0)
         throw ImportError("--sim-unplug", 0, "only the simulated controller (--input sim:PROGRAM) can be unplugged");
 
-    if (input.rfind("sim:", 0) == 0) {
+    if (use_device) {
+        device.config = input::apply_input_config_text(input::InputConfig{}, embedded::find("config/input.toml"),
+                                                       "config/input.toml");
+        p.device = &device;
+        p.total_ticks = std::numeric_limits<std::uint64_t>::max();  // until stopped
+        source = "controller (" + device.backend + ")";
+    } else if (input.rfind("sim:", 0) == 0) {
         const StickProgram program = load_program(input.substr(4));
         std::vector<UnplugWindow> unplug;
         for (size_t i = 0; i + 1 < o.unplug.size(); i += 2) unplug.push_back({o.unplug[i], o.unplug[i + 1]});
@@ -148,8 +198,9 @@ int run_command(const RunOptions& o) {
     p.stop_request_time_ns = &g_stop_requested_ns;
 
     if (p.total_ticks == std::numeric_limits<std::uint64_t>::max())
-        fmt::print("marionette: {} run, {} at {} Hz until the window is closed{}\n", render::platform_name(kind), source,
-                   config.tick_rate_hz, o.fast ? " (no real-time pacing)" : "");
+        fmt::print("marionette: {} run, {} at {} Hz until {}{}\n", render::platform_name(kind), source,
+                   config.tick_rate_hz, p.display.gl ? "the window is closed" : "stopped (Ctrl-C)",
+                   o.fast ? " (no real-time pacing)" : "");
     else
         fmt::print("marionette: {} run, {} at {} Hz for {:.1f} s{}\n", render::platform_name(kind), source,
                    config.tick_rate_hz, static_cast<double>(p.total_ticks) / config.tick_rate_hz,
@@ -173,6 +224,7 @@ int run_command(const RunOptions& o) {
         r = run_pipeline(p);
     }
     if (!r.display_description.empty()) fmt::print("display: {}\n", r.display_description);
+    if (!r.input_description.empty()) fmt::print("input: {}\n", r.input_description);
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
 

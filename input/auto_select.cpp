@@ -47,7 +47,9 @@ BackendChoice choose_input_backend(const AutoSelectInputs& found) {
         const EvdevCandidate& e = found.evdev.front();
         return {BackendKind::evdev, "evdev: " + e.path + " " + ids(e.vendor_id, e.product_id) + note};
     }
-    if (found.sdl_available)
+    // SDL2 initialising says nothing about a pad: with zero joysticks it would
+    // open nothing and the run would sit idle, so "none" (the caller falls back).
+    if (found.sdl_available && found.sdl_joysticks > 0)
         return {BackendKind::sdl, "sdl: no hidraw or evdev gamepad; SDL2 sees " + std::to_string(found.sdl_joysticks) +
                                       " joystick(s)" + note};
     return {BackendKind::none, "no gamepad found by hidraw, evdev or SDL2" + note};

@@ -61,6 +61,9 @@ public:
     // Which backend and why ("hidraw: Sony DualSense 054c:0ce6"); set by start().
     const std::string& backend_description() const { return description_; }
     InputThreadStats stats() const;
+    // The running thread, so the pipeline can name it and apply the [realtime]
+    // priority and CPU like its own threads; not joinable before start().
+    std::thread& thread() { return thread_; }
 
 private:
     std::thread thread_;

@@ -120,7 +120,9 @@ check "demo: status lines" test "$(grep -c '^\[ *[0-9]*\.0 s\] ' demo.txt)" -ge 
 check "demo: finishes" grep -q "^demo finished" demo.txt
 
 # Errors: exit code 2 and a clear message.
-expect_error "evdev not available" 2 "--input evdev: not available in this build" "$bin" run --input evdev
+# No pad here (the umockdev tests cover a present one): a backend named outright fails at once.
+expect_error "evdev without a pad" 2 "--input evdev: no gamepad under /dev/input" "$bin" run --input evdev --duration 1 --display headless
+expect_error "device input is real time" 2 "--fast: needs a simulated or recorded input" "$bin" run --input evdev --fast --duration 1 --display headless
 expect_error "unknown input" 2 "expected auto, evdev, hidapi, sdl, sim:PROGRAM or log:FILE" "$bin" run --input joystick
 expect_error "unplug needs the simulated controller" 2 "only the simulated controller" "$bin" run --input log:f1.mlog --sim-unplug 1 1
 expect_error "missing log" 2 "cannot open file" "$bin" run --input log:missing.mlog

@@ -35,6 +35,8 @@ TEST_CASE("auto: SDL2 when neither hidraw nor evdev has a pad; none when SDL2 is
     in.sdl_available = true;
     in.sdl_joysticks = 1;
     CHECK(choose_input_backend(in).kind == BackendKind::sdl);
+    in.sdl_joysticks = 0;  // SDL2 works but sees no pad: nothing to open
+    CHECK(choose_input_backend(in).kind == BackendKind::none);
     in.sdl_available = false;
     const BackendChoice c = choose_input_backend(in);
     CHECK(c.kind == BackendKind::none);
