@@ -134,8 +134,13 @@ expect_error "bad realtime key" 2 "badrt.toml:2: realtime.input_priority: 120 is
 # A window (under a virtual X server when one is installed): render_es draws from
 # the render thread; the simulation is unaffected.
 if command -v xvfb-run >/dev/null; then
-  xvfb-run -a "$bin" run --display window --duration 2 --record win.mlog --trace win.csv >win.txt 2>win.err
-  check "window: run exits 0" test $? -eq 0
+  # Mesa's llvmpipe leaks a little from a module it unloads at exit, which
+  # LeakSanitizer cannot suppress (tests/CMakeLists.txt): no leak check for GL runs.
+  ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" LIBGL_ALWAYS_SOFTWARE=1 \
+    xvfb-run -a "$bin" run --display window --duration 2 --record win.mlog --trace win.csv >win.txt 2>win.err
+  win_rc=$?
+  check "window: run exits 0" test $win_rc -eq 0
+  [[ $win_rc -eq 0 ]] || tail -20 win.err
   check "window: names the GL platform" grep -q "^display: window" win.txt
   "$bin" replay win.mlog --trace win_b.csv >/dev/null
   check "window: --trace equals replay --trace" cmp -s win.csv win_b.csv

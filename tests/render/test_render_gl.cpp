@@ -19,11 +19,8 @@
 #include "render_es/image.hpp"
 #include "render_es/view.hpp"
 #include "runtime/puppet.hpp"
+#include "tests/alloc_counter.hpp"
 #include "tests/test_support.hpp"
-
-namespace marionette::test {
-std::uint64_t allocation_count();  // alloc_counter.cpp
-}
 
 using namespace marionette;
 

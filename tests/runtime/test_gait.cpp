@@ -9,21 +9,9 @@
 #include "runtime/gait.hpp"
 #include "runtime/puppet.hpp"
 #include "runtime/simulation.hpp"
+#include "tests/alloc_counter.hpp"
 
 using namespace marionette;
-
-// Counts heap allocations while enabled, so a test can prove step() makes none.
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0};
-}  // namespace
-void* operator new(std::size_t size) {
-    if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-    if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-    throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace {
 TickInput stick(double x, double y) {
@@ -260,9 +248,7 @@ TEST_CASE("step never allocates", "[gait]") {
     Terrain rubble;
     for (int i = 0; i < 50; ++i) rubble.boxes.push_back({-2.0f, -0.5f * i, 2.0f, -0.5f * i + 0.2f, 0.01f * (i % 8)});
     Simulation sim(SimConfig{}, rubble);
-    g_allocations = 0;
-    g_counting = true;
+    const std::uint64_t before = test::allocation_count();
     for (int k = 0; k < 240 * 4; ++k) sim.step(stick(0.3 * std::sin(k / 200.0), k < 700 ? 1.0 : 0.0));
-    g_counting = false;
-    CHECK(g_allocations.load() == 0);
+    CHECK(test::allocation_count() - before == 0);
 }

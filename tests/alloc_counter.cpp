@@ -1,6 +1,8 @@
-// Replaces the global operator new/delete of the render test program with
-// counting versions, so a test can show that a frame allocates nothing. Kept in
-// its own file so no caller sees (and inlines) the definitions.
+// Replaces the global operator new/delete of a test program with counting
+// versions, so a test can show that a tick or a frame allocates nothing. Every
+// form is replaced (nothrow, over-aligned), so no pointer from the library's or a
+// sanitizer's own operator new ever reaches these deletes. Kept in its own file
+// so no caller sees (and inlines) the definitions. Declared in alloc_counter.hpp.
 #include <atomic>
 #include <cstdint>
 #include <cstdlib>
@@ -24,8 +26,6 @@ void operator delete(void* p) noexcept { std::free(p); }
 void operator delete[](void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-// Every other form too, so no pointer from the library's (or a sanitizer's)
-// operator new ever reaches our delete: nothrow and over-aligned allocations.
 void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
     g_allocations.fetch_add(1, std::memory_order_relaxed);
     return std::malloc(size ? size : 1);
@@ -44,8 +44,3 @@ void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
 void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-
-// Mesa's driver leaks a little from a module it unloads at eglTerminate, which
-// LeakSanitizer can neither symbolize nor suppress (tests/CMakeLists.txt): leak
-// checking is off in this program; AddressSanitizer's other checks are not.
-extern "C" const char* __asan_default_options() { return "detect_leaks=0"; }
