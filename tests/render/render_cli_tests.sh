@@ -4,22 +4,7 @@
 set -uo pipefail
 bin=$1
 src=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-cd "$work"
-failures=0
-passes=0
-check() {  # check "what" command...
-  local what=$1; shift
-  if "$@"; then passes=$((passes + 1)); else echo "FAILED: $what"; failures=$((failures + 1)); fi
-}
-expect_error() {  # expect_error "what" exit_code "message substring" command...
-  local what=$1 code=$2 text=$3; shift 3
-  "$@" >out.txt 2>err.txt
-  local rc=$?
-  if [[ $rc -eq $code ]] && grep -qF -- "$text" err.txt; then passes=$((passes + 1)); else
-    echo "FAILED: $what (exit $rc, stderr: $(cat err.txt))"; failures=$((failures + 1)); fi
-}
+source "$src/tests/cli/check_lib.sh"
 png_size() { python3 -c "import struct,sys; d=open(sys.argv[1],'rb').read(24); print('%dx%d' % struct.unpack('>II', d[16:24]))" "$1"; }
 
 "$bin" record --program "$src/config/programs/walk_stop.prog" -o walk.mlog >/dev/null
