@@ -74,8 +74,11 @@ vec3 blended_swing(const GaitRig& rig, float blend, float u) {
 vec3 blended_pelvis(const GaitRig& rig, float blend, float phase) {
     return lerp(eval_keys(rig.walk.pelvis, rig.walk.pelvis_count, phase), eval_keys(rig.run.pelvis, rig.run.pelvis_count, phase), blend);
 }
-vec3 blended_hand(const GaitRig& rig, float blend, float phase) {
-    return lerp(eval_keys(rig.walk.hand, rig.walk.hand_count, phase), eval_keys(rig.run.hand, rig.run.hand_count, phase), blend);
+// The hand path and its velocity (metres per cycle of phase).
+HermiteSample blended_hand(const GaitRig& rig, float blend, float phase) {
+    const HermiteSample walk = sample_hermite(std::span<const HermiteKey>(rig.walk.hand.data(), static_cast<std::size_t>(rig.walk.hand_count)), phase);
+    const HermiteSample run = sample_hermite(std::span<const HermiteKey>(rig.run.hand.data(), static_cast<std::size_t>(rig.run.hand_count)), phase);
+    return {lerp(walk.position, run.position, blend), lerp(walk.velocity, run.velocity, blend)};
 }
 
 // Sole points relative to the ankle, in the foot frame: under the ankle, the
@@ -350,6 +353,7 @@ Placement plan_target(const GaitState& g, int foot, vec3 root, float heading, fl
 }
 
 constexpr float kShortestSwing = 0.12f;           // s: a late lift-off still swings this long
+constexpr float kWristDrag = 0.4f;                // hand tilt against its path's velocity, per m/cycle
 constexpr float kMaxTurnPerStepDeg = 90.0f;       // turning in place: most a foot turns in one swing
 constexpr float kMaxPelvisVerticalSpeed = 0.9f;   // m/s the pelvis follows its height target at, at most
 
@@ -676,9 +680,9 @@ void GaitPoseJob::run() const {
     for (int i = 0; i < 2; ++i) {
         const std::size_t clavicle = static_cast<std::size_t>(clavicles[i]);
         const vec3 shoulder = model_positions[clavicle + 1];
-        const vec3 path = blended_hand(r, g.run_blend, foot_phase(g.cycle_phase, i));
+        const HermiteSample hand = blended_hand(r, g.run_blend, foot_phase(g.cycle_phase, i));
         const vec3 rest(0.03f, 0.0f, 0.02f);
-        const vec3 offset = lerp(rest, path, g.activity);
+        const vec3 offset = lerp(rest, hand.position, g.activity);
         TwoBoneIkInput ik;
         ik.root = shoulder;
         ik.target = shoulder + h.left * (side_sign(i) * offset.x) + vec3(0.0f, offset.y - hang, 0.0f) + h.forward * offset.z;
@@ -690,7 +694,16 @@ void GaitPoseJob::run() const {
         const quat clavicle_rotation = model_rotations[clavicle];
         local_rotations[clavicle + 1] = quat_normalize(quat_mul(quat_conjugate(clavicle_rotation), s.upper_rotation));
         local_rotations[clavicle + 2] = quat_normalize(quat_mul(quat_conjugate(s.upper_rotation), s.lower_rotation));
-        // The hand continues the forearm.
+        // The wrist follows the hand path's swing direction: the hand trails the
+        // motion (follow-through), tilting against the path's velocity along the
+        // heading and sideways, by kWristDrag per metre per cycle; at rest it
+        // continues the forearm. quat_from_to: half-angle identity, no trig.
+        const vec3 forearm_down = quat_rotate(s.lower_rotation, vec3(0.0f, -1.0f, 0.0f));
+        const vec3 v = hand.velocity * g.activity;
+        const vec3 drag = h.forward * (-kWristDrag * v.z) + h.left * (-kWristDrag * side_sign(i) * v.x);
+        const vec3 hand_down = normalize3(forearm_down + drag, forearm_down);
+        const quat hand_rotation = quat_mul(quat_from_to(forearm_down, hand_down), s.lower_rotation);
+        local_rotations[clavicle + 3] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), hand_rotation));
     }
     fk.run();
 }

@@ -244,6 +244,65 @@ TEST_CASE("the swing foot clears a 20 cm step up and down", "[gait]") {
     CHECK(lowest > -1e-3f);
 }
 
+TEST_CASE("stepping down a 20 cm riser at a fast walk keeps the knees under 1500 deg/s and the soles above ground", "[gait]") {
+    SimConfig c;
+    Terrain step;
+    step.boxes.push_back({-3.0f, -3.0f, 3.0f, 1.0f, 0.2f});  // the puppet starts on top and walks off at z = −3
+    Simulation sim(c, step);
+    double fastest_knee = 0.0;
+    float lowest = 1e9f;
+    PuppetState previous = sim.state();
+    for (int k = 0; k < 240 * 4; ++k) {
+        sim.step(stick(0.0, 0.8));
+        const PuppetState& s = sim.state();
+        for (int shin : {kShinL, kShinR}) {
+            const std::size_t j = static_cast<std::size_t>(shin);
+            fastest_knee = std::max(fastest_knee, quat_angle_between(previous.local_rotations[j], s.local_rotations[j]) * 240.0 * det::kRadToDeg);
+        }
+        lowest = std::min(lowest, lowest_sole_clearance(s, step, c));
+        previous = s;
+    }
+    CHECK(sim.state().root_position.z < -4.0f);  // walked off the box
+    CHECK(sim.state().gait.feet[0].ground < 0.01f);
+    CHECK(fastest_knee < 1500.0);
+    CHECK(lowest > -1e-3f);
+}
+
+TEST_CASE("the hands trail their swing: wrist tilts against the hand path's motion, straight at rest", "[gait]") {
+    SimConfig c;
+    Simulation sim(c, Terrain{});
+    run_ticks(sim, stick(0.0, 0.0), 240);
+    for (int hand : {kHandL, kHandR})
+        CHECK(quat_angle_between(sim.state().local_rotations[static_cast<std::size_t>(hand)], quat_identity()) < 1e-4);
+    // Walking toward −Z: between ticks the hand's bone direction (−Y of its
+    // frame) turns away from the direction the wrist is moving in.
+    run_ticks(sim, stick(0.0, 0.7), 240 * 2);
+    double largest_tilt = 0.0;
+    int trailing = 0, samples = 0;
+    for (int k = 0; k < 240; ++k) {
+        const PuppetState before = sim.state();
+        sim.step(stick(0.0, 0.7));
+        const PuppetState& s = sim.state();
+        for (int hand : {kHandL, kHandR}) {
+            const std::size_t j = static_cast<std::size_t>(hand);
+            largest_tilt = std::max(largest_tilt, quat_angle_between(s.local_rotations[j], quat_identity()));
+            // Wrist velocity relative to the pelvis, along the heading (−Z).
+            const float moving = -((s.model_positions[j].z - s.model_positions[kPelvis].z) -
+                                   (before.model_positions[j].z - before.model_positions[kPelvis].z));
+            const vec3 forearm = quat_rotate(s.model_rotations[j - 1], vec3(0.0f, -1.0f, 0.0f));
+            const vec3 bone = quat_rotate(s.model_rotations[j], vec3(0.0f, -1.0f, 0.0f));
+            const float tilt_forward = -(bone.z - forearm.z);  // hand points further along −Z than the forearm
+            if (std::fabs(moving) > 1e-4f) {
+                ++samples;
+                if (moving * tilt_forward < 0.0f) ++trailing;
+            }
+        }
+    }
+    CHECK(largest_tilt > 5.0 * det::kDegToRad);
+    CHECK(samples > 100);
+    CHECK(trailing > samples * 8 / 10);
+}
+
 TEST_CASE("step never allocates", "[gait]") {
     Terrain rubble;
     for (int i = 0; i < 50; ++i) rubble.boxes.push_back({-2.0f, -0.5f * i, 2.0f, -0.5f * i + 0.2f, 0.01f * (i % 8)});
