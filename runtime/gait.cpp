@@ -378,6 +378,7 @@ float slope_speed_multiplier(const Terrain& terrain, const SimConfig& c, float x
     const vec3 n = query_ground(terrain, x, z).normal;
     const HeadingFrame h = heading_frame(heading);
     const float grade = n.y > 1e-3f ? -(n.x * h.forward.x + n.z * h.forward.z) / n.y : 0.0f;
+    if (grade == 0.0f) return 1.0f;  // level: what the formula gives, without the atan
     const double degrees = det::atan(std::fabs(static_cast<double>(grade))) * det::kRadToDeg;
     return clampf(1.0f - c.slope_speed_factor * static_cast<float>(degrees), 0.2f, 1.0f);
 }
@@ -705,7 +706,17 @@ void GaitPoseJob::run() const {
         const quat hand_rotation = quat_mul(quat_from_to(forearm_down, hand_down), s.lower_rotation);
         local_rotations[clavicle + 3] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), hand_rotation));
     }
-    fk.run();
+    // Only the arms changed since the full pass (hands are leaves; nothing after
+    // them hangs off an arm): redo forward kinematics for those six joints, with
+    // LocalToModelJob's arithmetic, so the result is the same bits as a full pass.
+    for (int clavicle : {kClavicleL, kClavicleR})
+        for (int j = clavicle + 1; j <= clavicle + 3; ++j) {
+            const std::size_t k = static_cast<std::size_t>(j);
+            const std::size_t p = static_cast<std::size_t>(parents[k]);
+            const quat parent_rotation = model_rotations[p];
+            model_rotations[k] = quat_mul(parent_rotation, local_rotations[k]);
+            model_positions[k] = model_positions[p] + quat_rotate(parent_rotation, local_translations[k]);
+        }
 }
 
 }  // namespace marionette
