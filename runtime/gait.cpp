@@ -604,10 +604,10 @@ void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const
             hard_limit = minf(hard_limit, f.ankle.y + drop_for(dx * dx + dz * dz, reach2));
             continue;
         }
-        // Narrowing to the planted reach as the foot comes down, so landing
-        // tightens nothing in one tick.
+        // The planted reach at lift-off and landing, the full leg mid-swing, so
+        // neither lifting nor landing changes the limit in one tick.
         const float u = clampf(f.progress, 0.0f, 1.0f);
-        const float swing_reach = full_reach + (rig.leg_reach - full_reach) * (u * u * (3.0f - 2.0f * u));
+        const float swing_reach = rig.leg_reach + (full_reach - rig.leg_reach) * (4.0f * u * (1.0f - u));
         hard_limit = minf(hard_limit, f.ankle.y + drop_for(dx * dx + dz * dz, swing_reach * swing_reach));
         const float rate = f.timed_rate > 0.0f ? f.timed_rate
                                                : minf(dphase / dt / maxf(1e-3f, 1.0f - f.lift_phase), 1.0f / kShortestSwing);
