@@ -114,6 +114,13 @@ Placement place_foot(const Terrain& terrain, const GaitRig& rig, float x, float 
         const vec3 p = ankle + quat_rotate(rotation, vec3(0.0f, -rig.ankle_height, ahead)) + vec3(0.0f, lift, 0.0f);
         misfit = maxf(misfit, query_ground(terrain, p.x, p.z).height - p.y - 0.02f);
     }
+    // Nor may the heel hang against a riser behind it: the swing comes down past
+    // an edge one path key (a few cm) before it lands, so ground behind the
+    // ankle rising above the sole would be clipped on the way down.
+    for (float behind : {0.04f, 0.08f}) {
+        const vec3 p = ankle + quat_rotate(rotation, vec3(0.0f, -rig.ankle_height, -behind)) + vec3(0.0f, lift, 0.0f);
+        misfit = maxf(misfit, query_ground(terrain, p.x, p.z).height - p.y);
+    }
     return {ankle + vec3(0.0f, lift, 0.0f), rotation, g.height + lift, misfit};
 }
 
@@ -141,52 +148,96 @@ float duty_for(const SimConfig& c, float speed) { return running(c, speed) ? c.r
 
 float foot_phase(float cycle_phase, int foot) { return frac(cycle_phase - (foot == 0 ? 0.0f : 0.5f)); }
 
-// Highest ground under the sole along the swing, dilated by one sample so the
-// foot rises before it reaches an edge.
-void build_envelope(FootState& f, const Terrain& terrain, const GaitRig& rig) {
-    // The toes point between the start and the target directions during the swing
-    // (a turn rotates the foot): sample both, and halfway.
-    const vec3 from = quat_rotate(f.start_rotation, vec3(0.0f, 0.0f, 1.0f));
-    const vec3 to = quat_rotate(f.target_rotation, vec3(0.0f, 0.0f, 1.0f));
-    const vec3 toes[3] = {from, to, normalize3(from + to, to)};
-    std::array<float, kEnvelopeSamples> raw{};
-    for (int i = 0; i < kEnvelopeSamples; ++i) {
-        const float t = static_cast<float>(i) / static_cast<float>(kEnvelopeSamples - 1);
-        const vec3 a = lerp(f.start, f.target, t);
+// The foot's rotation at step fraction s. It turns with the path, not with
+// time, so the toes point where the swing path's clearance floor looked for
+// them (build_swing_path); s already eases in and out over the swing (the
+// prototype's progress has zero tangents at both ends), so no further easing.
+quat swing_rotation(const FootState& f, float s) {
+    return quat_slerp(f.start_rotation, f.target_rotation, s);
+}
+
+// The swing path's Hermite keys from its heights: key i at s = i / (n − 1),
+// position (0, height, s · distance); vertical tangents are the harmonic mean of
+// the neighbouring slopes (zero at a peak, a valley and both ends), which keeps
+// each segment monotone: no overshoot above a key or dip below one.
+void swing_path_keys(const FootState& f, std::array<HermiteKey, kSwingPathKeys>& keys) {
+    constexpr int n = kSwingPathKeys;
+    const float spacing = 1.0f / static_cast<float>(n - 1);
+    const float distance = horizontal_distance(f.start, f.target);
+    for (int i = 0; i < n; ++i) {
+        const std::size_t k = static_cast<std::size_t>(i);
+        const float s = static_cast<float>(i) * spacing;
+        float slope = 0.0f;
+        if (i > 0 && i + 1 < n) {
+            const float before = (f.path_height[k] - f.path_height[k - 1]) / spacing;
+            const float after = (f.path_height[k + 1] - f.path_height[k]) / spacing;
+            if (before * after > 0.0f) slope = 2.0f * before * after / (before + after);
+        }
+        keys[k] = {s, vec3(0.0f, f.path_height[k], s * distance), vec3(0.0f, slope, distance)};
+    }
+}
+
+// The swing path (docs/gait.md): the ankle's height at evenly spaced fractions
+// s of the step's horizontal distance, as a monotone cubic Hermite spline in the
+// vertical plane of the step, (height, horizontal distance) against s.
+//
+// Each interior key is the higher of the prototype's shape there (the line from
+// lift-off to landing plus the blended lift) and the clearance floor: the highest
+// ground under the sole (ankle, ball, toe tip, for the toe directions of the
+// start, the target and halfway) at that key and both neighbours, plus the
+// ankle height and swing_clearance. Monotone tangents keep the curve between two
+// keys within their heights, so the sole clears every sampled ground between
+// them: the path rises before a step up and comes down only past a step edge.
+void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, const SimConfig& c, float blend) {
+    constexpr int n = kSwingPathKeys;
+    // The toes at a key point between their directions at the neighbouring keys.
+    std::array<vec3, n> toe_direction{};
+    for (int i = 0; i < n; ++i)
+        toe_direction[static_cast<std::size_t>(i)] =
+            quat_rotate(swing_rotation(f, static_cast<float>(i) / static_cast<float>(n - 1)), vec3(0.0f, 0.0f, 1.0f));
+    std::array<float, n> ground{};
+    for (int i = 0; i < n; ++i) {
+        const float s = static_cast<float>(i) / static_cast<float>(n - 1);
+        const vec3 a = lerp(f.start, f.target, s);
         float h = query_ground(terrain, a.x, a.z).height;
+        const vec3 toes[3] = {toe_direction[static_cast<std::size_t>(i > 0 ? i - 1 : 0)], toe_direction[static_cast<std::size_t>(i)],
+                              toe_direction[static_cast<std::size_t>(i + 1 < n ? i + 1 : n - 1)]};
         for (const vec3& forward : toes)
             for (float r : {rig.foot_length, rig.foot_length + rig.toe_length})
                 h = maxf(h, query_ground(terrain, a.x + forward.x * r, a.z + forward.z * r).height);
-        raw[static_cast<std::size_t>(i)] = h;
+        ground[static_cast<std::size_t>(i)] = h;
     }
-    f.envelope = raw;
-}
-
-float dilated_envelope(const FootState& f, int i) {
-    float h = f.envelope[static_cast<std::size_t>(i)];
-    if (i > 0) h = maxf(h, f.envelope[static_cast<std::size_t>(i - 1)]);
-    if (i + 1 < kEnvelopeSamples) h = maxf(h, f.envelope[static_cast<std::size_t>(i + 1)]);
-    return h;
-}
-
-// The floor the swing sole keeps above at `fraction` of the step: every
-// (dilated) envelope sample, falling off at a grade of kFloorGrade on either
-// side, so the foot rises before an edge and comes down after it gradually.
-constexpr float kFloorGrade = 0.6f;
-float envelope_at(const FootState& f, float fraction, float distance) {
-    float floor = -1e9f;
-    const float spacing = 1.0f / static_cast<float>(kEnvelopeSamples - 1);
-    for (int i = 0; i < kEnvelopeSamples; ++i) {
-        const float t = static_cast<float>(i) * spacing;
-        const float away = maxf(0.0f, std::fabs(fraction - t) - spacing) * distance;
-        floor = maxf(floor, dilated_envelope(f, i) - kFloorGrade * away);
+    // The prototype's lift against the fraction of the step it has covered:
+    // (fraction, lift) sampled evenly in swing progress, fraction rising.
+    constexpr int m = 24;
+    std::array<float, m + 1> shape_fraction{}, shape_lift{};
+    for (int j = 0; j <= m; ++j) {
+        const vec3 shape = blended_swing(rig, blend, static_cast<float>(j) / static_cast<float>(m));
+        shape_fraction[static_cast<std::size_t>(j)] = clampf(shape.z, 0.0f, 1.0f);
+        shape_lift[static_cast<std::size_t>(j)] = shape.y;
     }
-    return floor;
+    int j = 0;
+    f.path_height[0] = f.start.y;
+    f.path_height[static_cast<std::size_t>(n - 1)] = f.target.y;
+    for (int i = 1; i + 1 < n; ++i) {
+        const float s = static_cast<float>(i) / static_cast<float>(n - 1);
+        while (j + 1 < m && shape_fraction[static_cast<std::size_t>(j + 1)] < s) ++j;
+        const float f0 = shape_fraction[static_cast<std::size_t>(j)], f1 = shape_fraction[static_cast<std::size_t>(j + 1)];
+        const float w = f1 > f0 ? clampf((s - f0) / (f1 - f0), 0.0f, 1.0f) : 1.0f;
+        const float lift = shape_lift[static_cast<std::size_t>(j)] + (shape_lift[static_cast<std::size_t>(j + 1)] - shape_lift[static_cast<std::size_t>(j)]) * w;
+        const float shaped = f.start.y + (f.target.y - f.start.y) * s + lift * f.lift_scale;
+        const std::size_t k = static_cast<std::size_t>(i);
+        const float floor = maxf(ground[k], maxf(ground[k - 1], ground[k + 1])) + rig.ankle_height + c.swing_clearance;
+        f.path_height[k] = maxf(shaped, floor);
+    }
+    std::array<HermiteKey, kSwingPathKeys> keys{};
+    swing_path_keys(f, keys);
+    f.path_length = build_arc_length_table(keys);
 }
 
 // Starts (or re-aims) a swing from where the foot is now toward a planted target.
-void begin_swing(FootState& f, const Placement& target, const Terrain& terrain, const GaitRig& rig, float lift_phase,
-                 float timed_rate) {
+void begin_swing(FootState& f, const Placement& target, const Terrain& terrain, const GaitRig& rig, const SimConfig& c,
+                 float blend, float lift_phase, float timed_rate) {
     f.start = f.ankle;
     f.start_rotation = f.rotation;
     f.start_ground = f.ground;
@@ -200,28 +251,30 @@ void begin_swing(FootState& f, const Placement& target, const Terrain& terrain, 
     const float distance = horizontal_distance(f.start, f.target);
     f.lift_scale = clampf(distance / 0.3f, 0.35f, 1.0f);
     f.swinging = 1;
-    build_envelope(f, terrain, rig);
+    build_swing_path(f, terrain, rig, c, blend);
 }
 
-// Where the swing puts the foot at progress u (prototype fitted to the step).
+// Where the swing puts the foot at progress u. The blended prototype's z says
+// what share of the path's length (arc length, climbing and descending
+// included) the foot has covered by then: the arc-length table turns that into
+// the step fraction s, so a foot stepping down a riser slows its horizontal
+// progress while it descends instead of dropping in a few ticks.
 void evaluate_swing(FootState& f, int foot, const SimConfig& c, const GaitRig& rig, float blend, vec3 left) {
+    (void)c;
     const float u = clampf(f.progress, 0.0f, 1.0f);
-    const vec3 shape = blended_swing(rig, blend, u);  // (sideways, lift, fraction)
-    const float fraction = clampf(shape.z, 0.0f, 1.0f);
-    float y = f.start.y + (f.target.y - f.start.y) * fraction + shape.y * f.lift_scale;
-    // Clearance: between its ends the sole stays swing_clearance above the
-    // highest ground under it; the blend weight is 0 at both ends so the path
-    // still starts and ends exactly at the planted positions.
-    const float floor_y = envelope_at(f, fraction, horizontal_distance(f.start, f.target)) + rig.ankle_height + c.swing_clearance;
-    const float weight = clampf(minf(u, 1.0f - u) / 0.12f, 0.0f, 1.0f);
-    if (y < floor_y) y += (floor_y - y) * weight;
-    f.fraction = fraction;
-    vec3 p = lerp(f.start, f.target, fraction) + left * (side_sign(foot) * shape.x * f.lift_scale);
-    p.y = y;
+    const vec3 shape = blended_swing(rig, blend, u);  // (sideways, lift, share of the path)
+    const float share = clampf(shape.z, 0.0f, 1.0f);
+    std::array<HermiteKey, kSwingPathKeys> keys{};
+    swing_path_keys(f, keys);
+    const std::span<const HermiteKey> path(keys.data(), keys.size());
+    const float total = f.path_length.total();
+    const float s = total > 1e-6f ? clampf(time_at_arc_length(path, f.path_length, share * total), 0.0f, 1.0f) : share;
+    f.fraction = s;
+    vec3 p = lerp(f.start, f.target, s) + left * (side_sign(foot) * shape.x * f.lift_scale);
+    p.y = sample_hermite(path, s).position.y;
     f.ankle = p;
-    const float s = u * u * (3.0f - 2.0f * u);
-    f.rotation = quat_slerp(f.start_rotation, f.target_rotation, s);
-    f.ground = f.start_ground + (f.target_ground - f.start_ground) * fraction;
+    f.rotation = swing_rotation(f, s);
+    f.ground = f.start_ground + (f.target_ground - f.start_ground) * s;
 }
 
 void land(FootState& f, GaitState& g) {
@@ -295,6 +348,10 @@ Placement plan_target(const GaitState& g, int foot, vec3 root, float heading, fl
     const vec3 spot = root_then + then.forward * ahead + then.left * (side_sign(foot) * rig.hip_half_width);
     return place_foot_on_flat_spot(terrain, rig, spot.x, spot.z, then.forward);
 }
+
+constexpr float kShortestSwing = 0.12f;           // s: a late lift-off still swings this long
+constexpr float kMaxTurnPerStepDeg = 90.0f;       // turning in place: most a foot turns in one swing
+constexpr float kMaxPelvisVerticalSpeed = 0.9f;   // m/s the pelvis follows its height target at, at most
 
 // Standing spot for a foot beside the other (planted) foot.
 Placement stop_target(const GaitState& g, int foot, float heading, const GaitRig& rig, const Terrain& terrain) {
@@ -430,7 +487,7 @@ void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const
                                                : stop_target(g, i, heading, rig, terrain);
             // Short, but never faster than 3 m/s for the foot.
             const float time = clampf(maxf(remaining, horizontal_distance(f.ankle, p.ankle) / 3.0f), 0.15f, c.stop_transition_s);
-            begin_swing(f, p, terrain, rig, 0.0f, 1.0f / time);
+            begin_swing(f, p, terrain, rig, c, g.run_blend, 0.0f, 1.0f / time);
         }
     }
 
@@ -444,12 +501,12 @@ void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const
         // Turning in place: small steps to the hip's spot under the turned heading.
         const float time_to_land = predict_landing(c, g.speed, g.commanded_speed, 1.0f - psi, true, dt).time;
         const double turn = det::wrap_angle(static_cast<double>(desired_heading) - heading);
-        const double max_turn = c.turn_rate_deg_s * det::kDegToRad * time_to_land;
+        // Small steps: a foot turns at most kMaxTurnPerStep per swing.
+        const double max_turn = minf(c.turn_rate_deg_s * time_to_land, kMaxTurnPerStepDeg) * det::kDegToRad;
         const HeadingFrame then = heading_frame(heading + (turn > max_turn ? max_turn : (turn < -max_turn ? -max_turn : turn)));
         const vec3 spot = root + then.left * (side_sign(i) * rig.hip_half_width);
         return place_foot_on_flat_spot(terrain, rig, spot.x, spot.z, then.forward);
     };
-    constexpr float kShortestSwing = 0.12f;  // s: a late lift-off still swings this long
     for (int i = 0; i < 2; ++i) {
         FootState& f = g.feet[static_cast<std::size_t>(i)];
         FootState& other = g.feet[static_cast<std::size_t>(1 - i)];
@@ -469,7 +526,7 @@ void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const
                     const Placement p = aim(i, psi);
                     if (horizontal_distance(p.ankle, f.target) > 0.06f) {
                         const float ground = f.ground;
-                        begin_swing(f, p, terrain, rig, psi, 0.0f);
+                        begin_swing(f, p, terrain, rig, c, g.run_blend, psi, 0.0f);
                         f.start_ground = ground;
                         f.replanned = 1;
                     }
@@ -482,7 +539,7 @@ void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const
             const float psi = foot_phase(g.cycle_phase, i);
             const bool walking = !running(c, g.speed);
             if (psi >= plan.duty && (!walking || !other.swinging)) {
-                begin_swing(f, aim(i, psi), terrain, rig, psi, 0.0f);
+                begin_swing(f, aim(i, psi), terrain, rig, c, g.run_blend, psi, 0.0f);
                 f.planned_speed = g.commanded_speed;
                 f.planned_heading = desired_heading;
                 evaluate_swing(f, i, c, rig, g.run_blend, h.left);
@@ -495,7 +552,7 @@ void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const
         if (std::fabs(along) > 0.05f) {
             const int trailing = along < 0.0f ? 0 : 1;
             const Placement p = stop_target(g, trailing, heading, rig, terrain);
-            begin_swing(g.feet[static_cast<std::size_t>(trailing)], p, terrain, rig, 0.0f, 1.0f / maxf(0.25f, c.stop_transition_s * 1.5f));
+            begin_swing(g.feet[static_cast<std::size_t>(trailing)], p, terrain, rig, c, g.run_blend, 0.0f, 1.0f / maxf(0.25f, c.stop_transition_s * 1.5f));
             evaluate_swing(g.feet[static_cast<std::size_t>(trailing)], trailing, c, rig, g.run_blend, h.left);
         } else {
             g.mode = GaitMode::idle;
@@ -524,17 +581,41 @@ void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const
     const double breath = det::sin(det::kTwoPi * in.breath_time / c.breath_period_s);
     vec3 pelvis = root + h.left * (bob.x * stance_side) + h.forward * bob.z;
     pelvis.y = g.pelvis_base + c.gait_pelvis_height + bob.y + static_cast<float>(breath) * c.breath_amplitude * (1.0f - g.activity);
+    // Planted feet bind exactly (within the IK's exact zone). A swinging foot
+    // binds where it will land, seen from where its hip will be then, and the
+    // pelvis moves toward that height at a bounded vertical speed, so stepping
+    // down lowers it over the swing instead of in the last few ticks; the swing
+    // foot now only has to stay within the full leg (the IK's soft reach).
+    const float reach2 = rig.leg_reach * rig.leg_reach;
+    const float full_reach = 0.995f * (rig.thigh + rig.shin);
+    const auto drop_for = [](float horizontal2, float r2) { return std::sqrt(maxf(r2 - horizontal2, 0.09f * r2)); };
+    float hard_limit = 1e9f;
+    float soft_limit = 1e9f;
     for (int i = 0; i < 2; ++i) {
         const FootState& f = g.feet[static_cast<std::size_t>(i)];
         const vec3 hip = pelvis + h.left * (side_sign(i) * rig.hip_half_width);
         const float dx = f.ankle.x - hip.x, dz = f.ankle.z - hip.z;
-        const float horizontal2 = dx * dx + dz * dz;
-        const float reach2 = rig.leg_reach * rig.leg_reach;
-        const float drop = std::sqrt(maxf(reach2 - horizontal2, 0.09f * reach2));
-        // Swinging feet bind too: a leg beyond reach would snap toward straight.
-        const float limit = f.ankle.y + drop;
-        pelvis.y = minf(pelvis.y, limit);
+        if (!f.swinging) {
+            hard_limit = minf(hard_limit, f.ankle.y + drop_for(dx * dx + dz * dz, reach2));
+            continue;
+        }
+        // Narrowing to the planted reach as the foot comes down, so landing
+        // tightens nothing in one tick.
+        const float u = clampf(f.progress, 0.0f, 1.0f);
+        const float swing_reach = full_reach + (rig.leg_reach - full_reach) * (u * u * (3.0f - 2.0f * u));
+        hard_limit = minf(hard_limit, f.ankle.y + drop_for(dx * dx + dz * dz, swing_reach * swing_reach));
+        const float rate = f.timed_rate > 0.0f ? f.timed_rate
+                                               : minf(dphase / dt / maxf(1e-3f, 1.0f - f.lift_phase), 1.0f / kShortestSwing);
+        const float remaining = maxf(0.0f, 1.0f - f.progress) / rate;
+        const vec3 hip_then = hip + h.forward * (g.speed * remaining);
+        const float tx = f.target.x - hip_then.x, tz = f.target.z - hip_then.z;
+        soft_limit = minf(soft_limit, f.target.y + drop_for(tx * tx + tz * tz, reach2));
     }
+    const float previous_y = g.pelvis.y;
+    const float max_move = kMaxPelvisVerticalSpeed * dt;
+    pelvis.y = minf(pelvis.y, soft_limit);
+    pelvis.y = clampf(pelvis.y, previous_y - max_move, previous_y + max_move);
+    pelvis.y = minf(pelvis.y, hard_limit);
     g.pelvis = pelvis;
     const float lean_target = minf(c.max_spine_lean_deg, c.spine_lean_deg_per_m_s * g.speed) * static_cast<float>(det::kDegToRad);
     g.lean = approach(g.lean, lean_target, c.interpolation_rate, dt);

@@ -19,7 +19,7 @@
 
 namespace marionette {
 
-inline constexpr int kEnvelopeSamples = 12;
+inline constexpr int kSwingPathKeys = 20;
 
 enum class GaitMode : std::int32_t { idle = 0, stepping = 1, stopping = 2 };
 
@@ -43,9 +43,11 @@ struct FootState {
     std::int32_t replanned = 0;               // a swing re-aims at most once
     float planned_speed = 0.0f;               // the command the target was planned for
     float planned_heading = 0.0f;
-    // Highest ground under the sole (ankle, ball, toe tip) at evenly spaced
-    // fractions of the step: the swing keeps clear of it (steps up, box edges).
-    std::array<float, kEnvelopeSamples> envelope{};
+    // The swing path: ankle height at evenly spaced fractions of the step, clear
+    // of the ground under the sole (steps up, box edges), and its arc-length
+    // table (the foot's progress along it is by length: docs/gait.md).
+    std::array<float, kSwingPathKeys> path_height{};
+    ArcLengthTable path_length{};
 };
 
 struct GaitState {
