@@ -5,6 +5,7 @@
 #include <array>
 #include <future>
 #include <memory>
+#include <optional>
 
 #include "input/evdev/evdev_backend.hpp"
 #include "input/hid/hid_pad.hpp"
@@ -26,6 +27,23 @@ DeviceFamily family_of(HidFormat f) {
     return DeviceFamily::evdev;
 }
 }  // namespace
+
+std::unique_ptr<HidTransport> open_first_hid_pad(const std::string& wanted_path, HidFormat& format, std::string& path,
+                                                std::string& error) {
+    for (const HidDeviceInfo& p : enumerate_hid_pads())
+        if (wanted_path.empty() || p.path == wanted_path) {
+            std::unique_ptr<HidTransport> transport = open_hidapi_transport(p.path);
+            if (!transport) {
+                error = p.path + ": cannot open the hidraw node (permissions? see docs/input.md)";
+                return nullptr;
+            }
+            path = p.path;
+            format = p.format;
+            return transport;
+        }
+    error = wanted_path.empty() ? "no supported HID pad found" : wanted_path + ": not a supported HID pad";
+    return nullptr;
+}
 
 BackendChoice probe_input_backend(const std::string& evdev_dir) {
     AutoSelectInputs found;
@@ -103,25 +121,17 @@ bool InputThread::start(InputRing& ring, const InputThreadOptions& options, std:
                 break;
             }
             case BackendKind::hidraw: {
-                std::string path = options_.device_path;
+                const HidOpener& open = options_.open_hid ? options_.open_hid : open_first_hid_pad;
                 HidFormat format = HidFormat::ds4;
-                const std::vector<HidDeviceInfo> pads = enumerate_hid_pads();
-                bool known = false;
-                for (const HidDeviceInfo& p : pads)
-                    if (path.empty() || p.path == path) {
-                        path = p.path;
-                        format = p.format;
-                        known = true;
-                        break;
-                    }
-                std::unique_ptr<HidTransport> transport = known ? open_hidapi_transport(path) : nullptr;
+                std::string path, err;
+                std::unique_ptr<HidTransport> transport = open(options_.device_path, format, path, err);
                 if (!transport) {
-                    started.set_value(known ? path + ": cannot open the hidraw node (permissions? see docs/input.md)"
-                                            : "no supported HID pad found");
+                    started.set_value(err);
                     return;
                 }
-                HidPad pad(*transport, format);
-                if (!pad.initialise(200)) {
+                std::optional<HidPad> pad;
+                pad.emplace(*transport, format);
+                if (!pad->initialise(200)) {
                     started.set_value(path + ": the pad did not accept its start-up reports");
                     return;
                 }
@@ -130,22 +140,48 @@ bool InputThread::start(InputRing& ring, const InputThreadOptions& options, std:
                 connected_ = true;
                 connects_ = 1;
                 InputRingWriter<InputRing> writer(ring);
-                const FamilyCalibration& cal = options_.config.family(family_of(format));
+                const FamilyCalibration* cal = &options_.config.family(family_of(format));
+                std::uint64_t rejected_by_earlier_pads = 0;
                 InputSample s;
                 while (!stop_requested_.load(std::memory_order_relaxed)) {
-                    const HidPad::Result r = pad.read(s, 1);
+                    if (!pad) {
+                        // Unplugged: look for the pad again now and then (hidraw
+                        // gives no hotplug events; this is off the steady state).
+                        for (int waited = 0; waited < options_.hid_reopen_interval_ms &&
+                                             !stop_requested_.load(std::memory_order_relaxed);
+                             waited += 10)
+                            usleep(10'000);
+                        transport = open(options_.device_path, format, path, err);
+                        if (!transport) continue;
+                        pad.emplace(*transport, format);
+                        if (!pad->initialise(200)) {
+                            pad.reset();
+                            transport.reset();
+                            continue;
+                        }
+                        cal = &options_.config.family(family_of(format));
+                        connected_.store(true, std::memory_order_release);
+                        connects_.fetch_add(1);
+                        continue;
+                    }
+                    const HidPad::Result r = pad->read(s, 1);
                     if (r == HidPad::Result::sample) {
                         s.t_ns = monotonic_now_ns();
-                        apply_calibration(cal, options_.raw, s);
+                        apply_calibration(*cal, options_.raw, s);
                         if (writer.push(to_timed_input(s))) samples_.fetch_add(1, std::memory_order_relaxed);
                         ring_dropped_.store(writer.dropped(), std::memory_order_relaxed);
                     } else if (r == HidPad::Result::rejected) {
-                        rejected_.store(pad.counters().rejected(), std::memory_order_relaxed);
+                        rejected_.store(rejected_by_earlier_pads + pad->counters().rejected(),
+                                        std::memory_order_relaxed);
                     } else if (r == HidPad::Result::disconnected) {
+                        // The simulation sees the disconnect (the puppet idles) until
+                        // the pad is back.
                         writer.push_disconnect(monotonic_now_ns());
-                        connected_ = false;
+                        connected_.store(false, std::memory_order_release);
                         disconnects_.fetch_add(1);
-                        break;  // the pipeline sees device_connected() == false
+                        rejected_by_earlier_pads += pad->counters().rejected();
+                        pad.reset();  // before the transport it reads from
+                        transport.reset();
                     }
                 }
                 break;

@@ -14,11 +14,15 @@
 //   input.stop();
 #include <atomic>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <string>
 #include <thread>
 
 #include "input/auto_select.hpp"
 #include "input/calibration.hpp"
+#include "input/hid/hid_report.hpp"
+#include "input/hid/hid_transport.hpp"
 #include "runtime/spsc_ring.hpp"
 #include "runtime/tick_input_assembler.hpp"
 
@@ -27,12 +31,22 @@ namespace marionette::input {
 // 4096 samples: 0.5 s at 8 kHz, far more than one tick's worth.
 using InputRing = SpscRing<TimedInput, 4096>;
 
+// How the hidraw backend reaches a pad: opens `wanted_path` (empty: the first
+// supported pad), sets its format and path, or returns null with `error` set.
+using HidOpener = std::function<std::unique_ptr<HidTransport>(const std::string& wanted_path, HidFormat& format,
+                                                              std::string& path, std::string& error)>;
+// The default opener: hidapi enumeration and hidraw.
+std::unique_ptr<HidTransport> open_first_hid_pad(const std::string& wanted_path, HidFormat& format, std::string& path,
+                                                std::string& error);
+
 struct InputThreadOptions {
     std::string backend = "auto";         // auto, hidraw, evdev, sdl
     std::string device_path;              // evdev node or hidraw node; empty: the first found
     std::string evdev_dir = "/dev/input";
     bool raw = false;                     // skip deadzone and response curve
     InputConfig config;                   // calibration per family, SDL mapping file
+    HidOpener open_hid;                   // empty: open_first_hid_pad (tests hand in firmware_sim)
+    int hid_reopen_interval_ms = 250;     // how often an unplugged hidraw pad is looked for
 };
 
 struct InputThreadStats {

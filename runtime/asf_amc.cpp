@@ -38,7 +38,7 @@
 //   hierarchy lists them (as the CMU BVH conversions do), without recursion.
 // - AMC frames must be numbered 1, 2, 3, ... and list every bone that has
 //   dofs exactly once with exactly one value per dof.
-// - Limits: at most kMaxBones bones, |number| <= kMaxMagnitude, frames ×
+// - Limits: at most kMaxBones bones, |number| <= kMaxTextNumber (runtime/text_number.hpp), frames ×
 //   joints <= kMaxPoseSamples; frames are stored as they are read, so no
 //   allocation is sized by a number from the file.
 // - Control bytes other than whitespace are refused up front (binary files).
@@ -53,6 +53,8 @@
 #include <unordered_map>
 #include <utility>
 #include <vector>
+
+#include "runtime/text_number.hpp"
 
 namespace marionette {
 
@@ -74,7 +76,6 @@ namespace {
 
 constexpr int kMaxBones = 1023;  // plus the root: the BVH importer's 1024 joints
 constexpr std::int64_t kMaxPoseSamples = std::int64_t{1} << 24;
-constexpr double kMaxMagnitude = 1.0e9;
 constexpr std::size_t kMaxQuotedChars = 40;
 constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{512} << 20;
 // Shorter directions carry no usable orientation.
@@ -198,33 +199,6 @@ private:
 
 // ---------------------------------------------------------------- numbers
 
-enum class NumberStatus { ok, not_a_number, not_finite, too_large };
-
-// "1", "-.5", "7.62852e-016", "+2"; nan, inf and out-of-range are refused.
-NumberStatus parse_real(std::string_view token, double& out) {
-    const char* first = token.data();
-    const char* last = token.data() + token.size();
-    if (last - first > 1 && *first == '+' && (first[1] == '.' || (first[1] >= '0' && first[1] <= '9'))) ++first;
-    double value = 0.0;
-    const auto result = std::from_chars(first, last, value, std::chars_format::general);
-    if (result.ec == std::errc::result_out_of_range && result.ptr == last) return NumberStatus::too_large;
-    if (result.ec != std::errc() || result.ptr != last) return NumberStatus::not_a_number;
-    if (!std::isfinite(value)) return NumberStatus::not_finite;
-    if (value > kMaxMagnitude || value < -kMaxMagnitude) return NumberStatus::too_large;
-    out = value;
-    return NumberStatus::ok;
-}
-
-bool parse_integer(std::string_view token, std::int64_t& out) {
-    const char* first = token.data();
-    const char* last = token.data() + token.size();
-    if (last - first > 1 && *first == '+' && first[1] >= '0' && first[1] <= '9') ++first;
-    std::int64_t value = 0;
-    const auto result = std::from_chars(first, last, value);
-    if (result.ec != std::errc() || result.ptr != last) return false;
-    out = value;
-    return true;
-}
 
 double read_number(const LineReader& reader, int line, std::string_view token, const std::string& what) {
     double value = 0.0;

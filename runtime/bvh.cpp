@@ -15,7 +15,7 @@
 //   kNoParent (the Skeleton supports several roots).
 // - Limits: at most kMaxJoints joints, 0..6 channels per joint (each channel at
 //   most once), Frames >= 1, Frames × joints <= kMaxPoseSamples, |value| <=
-//   kMaxMagnitude, Frame Time in [kMinFrameTime, inf). Every limit is checked
+//   kMaxTextNumber (runtime/text_number.hpp), Frame Time in [kMinFrameTime, inf). Every limit is checked
 //   before anything is allocated from it, and Frames is first checked against
 //   the bytes that actually follow (each value needs at least one character and
 //   a separator).
@@ -35,6 +35,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "runtime/text_number.hpp"
+
 namespace marionette {
 
 namespace {
@@ -46,7 +48,6 @@ constexpr int kMaxChannelsPerJoint = 6;
 constexpr std::int64_t kMaxPoseSamples = std::int64_t{1} << 24;
 // Larger offsets, positions or angles are nonsense and would lose all meaning
 // (or overflow) once stored as float.
-constexpr double kMaxMagnitude = 1.0e9;
 // One megahertz: anything faster is not a frame time.
 constexpr double kMinFrameTime = 1.0e-6;
 // Longest token quoted back in an error message.
@@ -97,37 +98,6 @@ std::string quote_token(std::string_view token) {
 
 // ---------------------------------------------------------------- numbers
 
-// A real number as BVH writers print it: "1", "-.5", ".0083333", "1.0E1",
-// "+2". std::from_chars accepts all but the leading '+', which is skipped here;
-// "nan", "inf" and anything out of range are refused.
-enum class NumberStatus { ok, not_a_number, not_finite, too_large };
-
-NumberStatus parse_real(std::string_view token, double& out) {
-    const char* first = token.data();
-    const char* last = token.data() + token.size();
-    if (first != last && *first == '+' && last - first > 1 && (first[1] == '.' || (first[1] >= '0' && first[1] <= '9')))
-        ++first;
-    double value = 0.0;
-    const auto result = std::from_chars(first, last, value, std::chars_format::general);
-    if (result.ec == std::errc::result_out_of_range && result.ptr == last) return NumberStatus::too_large;
-    if (result.ec != std::errc() || result.ptr != last) return NumberStatus::not_a_number;
-    if (!std::isfinite(value)) return NumberStatus::not_finite;
-    if (value > kMaxMagnitude || value < -kMaxMagnitude) return NumberStatus::too_large;
-    out = value;
-    return NumberStatus::ok;
-}
-
-// A whole number ("+" allowed); false for anything else, including overflow.
-bool parse_integer(std::string_view token, std::int64_t& out) {
-    const char* first = token.data();
-    const char* last = token.data() + token.size();
-    if (first != last && *first == '+' && last - first > 1 && first[1] >= '0' && first[1] <= '9') ++first;
-    std::int64_t value = 0;
-    const auto result = std::from_chars(first, last, value);
-    if (result.ec != std::errc() || result.ptr != last) return false;
-    out = value;
-    return true;
-}
 
 // ---------------------------------------------------------------- cursor
 
