@@ -12,6 +12,7 @@
 
 #include "app/cli.hpp"
 #include "app/config.hpp"
+#include "app/default_graph.hpp"
 #include "app/embedded.hpp"
 #include "app/files.hpp"
 #include "render_es/image.hpp"
@@ -36,6 +37,7 @@ struct GraphBuildCommandOptions {
     std::string dot_file;
     int threads = 0;
     bool json = false;
+    bool default_graph = false;  // --default: the embedded default graph (app/default_graph.hpp)
 };
 
 struct GraphInfoOptions {
@@ -174,7 +176,49 @@ std::string kept_range(const MotionGraph& g, int clip) {
 
 }  // namespace
 
+// `graph build --default`: the embedded default graph, exported for inspection.
+int graph_default_build_command(const GraphBuildCommandOptions& o) {
+    if (!o.clip_files.empty() || !o.asf_file.empty() || !o.labels_file.empty())
+        throw ImportError("command line", 0, "--default builds the embedded clips: give no CLIPS, --asf or --labels with it");
+    const SimConfig config = load_config(o.config_file);
+    graph::GraphBuildHooks hooks;
+    if (!o.plot_file.empty()) hooks.plot_size = 1024;
+    const DefaultGraphBuild build = build_default_motion_graph_report(config, hooks);
+    const graph::GraphBuildOutput& out = build.output;
+    const MotionGraph& g = out.graph;
+    write_binary_file(o.output_file, serialize_motion_graph(g));
+    if (!o.plot_file.empty()) write_plot(o.plot_file, out);
+    if (!o.dot_file.empty()) write_text_file(o.dot_file, dot_text(g));
+    const double kept_pct = out.frames > 0 ? 100.0 * static_cast<double>(g.stats.frames_kept) / out.frames : 0.0;
+    const std::vector<std::string> kept = kept_clip_names(g);
+    std::string labels_kept;
+    for (const LabelReachability& l : out.prune.labels)
+        if (l.clips_kept > 0) labels_kept += (labels_kept.empty() ? "" : ",") + json::quote(l.label);
+    if (o.json) {
+        std::string clips;
+        for (const std::string& c : kept) clips += (clips.empty() ? "" : ",") + json::quote(c);
+        fmt::print("{{\"output\":{},\"default\":true,\"clips\":{},\"frames\":{},\"candidates\":{},\"bridges\":{},"
+                   "\"nodes_before\":{},\"edges_before\":{},\"nodes\":{},\"edges\":{},\"frames_kept_pct\":{},"
+                   "\"clips_kept\":[{}],\"labels_kept\":[{}],\"source_hash\":\"{:016x}\",\"build_ms\":{},\"build_seconds\":{},"
+                   "\"peak_rss_mb\":{}}}\n",
+                   json::quote(o.output_file), build.clips, out.frames, out.regular_candidates, out.bridges,
+                   out.prune.nodes_before, out.prune.edges_before, out.prune.nodes, out.prune.edges,
+                   json::number(kept_pct), clips, labels_kept, g.source_hash, json::number(build.build_ms),
+                   json::number(build.build_ms / 1000.0), json::number(peak_rss_mb()));
+    } else {
+        fmt::print("default graph: {} clips, {} frames, {} candidate transitions, {} bridges\n", build.clips, out.frames,
+                   out.regular_candidates, out.bridges);
+        fmt::print("graph {} nodes / {} edges → {} nodes / {} edges, {:.1f}% of frames kept\n", out.prune.nodes_before,
+                   out.prune.edges_before, out.prune.nodes, out.prune.edges, kept_pct);
+        fmt::print("clips kept: {}\nwrote {} in {:.0f} ms\n", fmt::join(kept, " "), o.output_file, build.build_ms);
+    }
+    return 0;
+}
+
 int graph_build_command(const GraphBuildCommandOptions& o) {
+    if (o.default_graph) return graph_default_build_command(o);
+    if (o.clip_files.empty())
+        throw ImportError("command line", 0, "graph build needs CLIPS (.bvh, or .amc with --asf), or --default");
     const SimConfig config = load_config(o.config_file);
     const graph::LabelRules rules = o.labels_file.empty()
                                         ? graph::parse_label_rules(std::string(embedded::find("config/graph_labels.toml")),
@@ -387,7 +431,8 @@ void register_graph_commands(CLI::App& app, int& exit_code) {
     auto b = std::make_shared<GraphBuildCommandOptions>();
     CLI::App* build = graph->add_subcommand("build", "Build a motion graph from BVH or ASF/AMC clips");
     build->add_option("--asf", b->asf_file, "skeleton for AMC clips")->check(CLI::ExistingFile);
-    build->add_option("clips", b->clip_files, "clip files (.bvh, or .amc with --asf)")->required();
+    build->add_option("clips", b->clip_files, "clip files (.bvh, or .amc with --asf)");
+    build->add_flag("--default", b->default_graph, "build the embedded default graph (project clips + gait locomotion)");
     build->add_option("-o,--output", b->output_file, "the .mgraph file to write")->required();
     build->add_option("--labels", b->labels_file, "labels file (TOML; default config/graph_labels.toml)")
         ->check(CLI::ExistingFile);
