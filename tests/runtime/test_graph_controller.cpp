@@ -8,6 +8,8 @@
 
 #include "runtime/det_math.hpp"
 #include "runtime/graph_controller.hpp"
+#include "runtime/simulation.hpp"
+#include "runtime/tick_input.hpp"
 #include "tests/alloc_counter.hpp"
 #include "tests/graph_fixture.hpp"
 
@@ -195,4 +197,36 @@ TEST_CASE("graph controller refuses a graph with a dead end", "[graph][controlle
     g.edges.erase(g.edges.begin() + 1, g.edges.begin() + 6);  // node 1's transitions
     index_edges(g);
     CHECK_THROWS_WITH(GraphController(g, GraphControllerConfig{}), Catch::Contains("no way out"));
+}
+
+TEST_CASE("a simulation driven by a motion graph walks, repeats its hashes and never allocates", "[graph][controller][simulation]") {
+    const auto graph = std::make_shared<const MotionGraph>(test::make_locomotion_graph());
+    const SimConfig config;
+    GraphControllerConfig controller;
+    controller.max_speed = 1.2;
+    const auto run = [&](std::vector<std::uint64_t>& hashes) {
+        Simulation sim(config);
+        const std::uint64_t gait_hash = sim.clip_data_hash();
+        sim.use_motion_graph(graph, controller, 0.5);
+        CHECK(sim.clip_data_hash() != gait_hash);
+        CHECK(sim.skeleton().joint_count() == 2);
+        TickInput in{};
+        in.left_x = static_cast<std::int16_t>(kStickScale);
+        const std::uint64_t before = test::allocation_count();
+        for (int t = 0; t < 1200; ++t) sim.step(in);
+        CHECK(test::allocation_count() == before);
+        for (int t = 0; t < 240; ++t) {
+            sim.step(in);
+            hashes.push_back(hash_state(sim.state()));
+        }
+        // Five seconds at 1.2 graph units/s × 0.5 m per unit, toward +X after the turn.
+        CHECK(sim.state().root_position.x > 1.5f);
+        CHECK(sim.state().motion_source == 1);
+        CHECK_THROWS_WITH(sim.use_motion_graph(graph, controller, 0.5), Catch::Contains("before the first tick"));
+    };
+    std::vector<std::uint64_t> a, b;
+    a.reserve(2000), b.reserve(2000);
+    run(a);
+    run(b);
+    CHECK(a == b);
 }
