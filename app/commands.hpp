@@ -26,6 +26,7 @@ struct RecordOptions {
     std::string config_file;
     unsigned chunk_ticks = 60;               // 250 ms at 240 Hz, as a live run flushes
     bool json = false;
+    std::string graph_file;                  // --graph: drive the puppet from this .mgraph
 };
 int record_command(const RecordOptions& options);
 
@@ -36,6 +37,7 @@ struct ReplayCommandOptions {
     std::string trace_csv;
     std::string joints_csv;
     std::string bvh;
+    std::string graph_file;                  // --graph: the .mgraph the log was recorded with
 };
 int replay_command(const ReplayCommandOptions& options);
 

@@ -35,4 +35,13 @@ graph::GraphBuildParams graph_build_params(const SimConfig& c) {
     return p;
 }
 
+void attach_motion_graph(Simulation& sim, std::shared_ptr<const MotionGraph> graph) {
+    GraphControllerConfig config;
+    const double leg = graph->leg_length > 0.0f ? graph->leg_length : 1.0;
+    config.max_speed = 1.5 * leg;
+    const char* const labels[4] = {"jump", "wave", "bow", "look_around"};
+    for (int b = 0; b < 4; ++b) config.button_label[static_cast<size_t>(b)] = graph->label_index(labels[b]);
+    sim.use_motion_graph(std::move(graph), config, 0.9 / leg);
+}
+
 }  // namespace marionette

@@ -2,17 +2,25 @@
 // Motion-graph files for the commands: loading a .mgraph (errors name the file
 // and byte) and the build parameters a configuration gives.
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "motion_graph/graph_builder.hpp"
 #include "runtime/motion_graph.hpp"
 #include "runtime/sim_config.hpp"
+#include "runtime/simulation.hpp"
 
 namespace marionette {
 
 MotionGraph load_motion_graph_file(const std::string& path);
 void write_binary_file(const std::string& path, const std::vector<std::uint8_t>& bytes);
 graph::GraphBuildParams graph_build_params(const SimConfig& config);
+
+// Drives `sim` from `graph` (`--graph` on record/replay): the controller's
+// defaults, full stick = 1.5 leg lengths per second, the graph scaled so a leg
+// is 0.9 m, and the face buttons south/east/west/north mapped to the labels
+// jump/wave/bow/look_around where the graph has them.
+void attach_motion_graph(Simulation& sim, std::shared_ptr<const MotionGraph> graph);
 
 }  // namespace marionette

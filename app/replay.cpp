@@ -8,6 +8,7 @@
 
 #include "app/config.hpp"
 #include "app/files.hpp"
+#include "app/graph_files.hpp"
 #include "runtime/bvh.hpp"
 
 namespace marionette {
@@ -48,6 +49,7 @@ ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name,
                                       log.header.tick_rate_hz, config.tick_rate_hz));
     set_simulation_float_mode();
     Simulation sim(config);
+    if (options.graph) attach_motion_graph(sim, options.graph);
     if (sim.clip_data_hash() != log.header.clip_data_hash)
         throw ImportError(log_name, 0,
                           fmt::format("recorded with different clip data (hash {:016x}, this build has {:016x})",

@@ -16,6 +16,7 @@ struct ReplayOptions {
     std::string joints_csv;     // per tick: every joint's world position
     std::string bvh;            // the performed motion as a BVH animation
     bool keep_tick_hashes = false;
+    std::shared_ptr<const MotionGraph> graph;  // --graph: drive the puppet from this graph
     // Called with the simulation at its starting state and after every tick
     // (`marionette render` draws frames from it). Returning false stops the replay.
     std::function<bool(const Simulation&)> on_tick;

@@ -13,6 +13,8 @@
 #include <random>
 
 #include "motion_graph/graph_builder.hpp"
+#include "runtime/det_math.hpp"
+#include "runtime/graph_controller.hpp"
 #include "runtime/graph_path.hpp"
 
 using namespace marionette;
@@ -193,10 +195,45 @@ void BM_PathQuery(benchmark::State& state) {
     state.counters["max_us"] = micros.back();
 }
 
+// The graph controller on the CMU-16 graph following a circle program (stick
+// direction turning at 0.5 rad/s) at 60 Hz: cost per tick, median, p99 and max.
+void BM_ControllerCircleCmu16(benchmark::State& state) {
+    static const GraphBuildOutput out = build_motion_graph(cmu16(), GraphBuildParams{});
+    const MotionGraph& g = out.graph;
+    GraphControllerConfig config;
+    config.max_speed = 1.5 * g.leg_length;
+    config.max_nodes_per_tick = static_cast<int>(state.range(0));
+    GraphController controller(g, config);
+    GraphControllerState s = controller.initial_state();
+    std::vector<quat> r(static_cast<size_t>(g.joint_count()));
+    std::vector<vec3> t(static_cast<size_t>(g.joint_count()));
+    std::vector<double> micros;
+    micros.reserve(1 << 20);
+    std::int64_t tick = 0;
+    for (auto _ : state) {
+        GraphControllerInput in;
+        in.dt = 1.0f / 60.0f;
+        const double a = 0.5 * static_cast<double>(tick++) / 60.0;
+        in.stick_x = static_cast<float>(det::sin(a));
+        in.stick_y = static_cast<float>(-det::cos(a));
+        const auto t0 = std::chrono::steady_clock::now();
+        controller.step(s, in, r, t);
+        micros.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count());
+        benchmark::DoNotOptimize(r.data());
+    }
+    std::sort(micros.begin(), micros.end());
+    state.counters["median_us"] = micros[micros.size() / 2];
+    state.counters["p99_us"] = micros[micros.size() * 99 / 100];
+    state.counters["max_us"] = micros.back();
+    state.counters["nodes_per_tick"] = static_cast<double>(s.nodes_expanded) / static_cast<double>(tick);
+    state.counters["transitions"] = static_cast<double>(s.transitions_taken);
+}
+
 }  // namespace
 
 BENCHMARK(BM_BuildCmu16)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_ReferenceSpeedup)->Arg(1000)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_PathQuery)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ControllerCircleCmu16)->Arg(64)->Arg(256)->Unit(benchmark::kMicrosecond)->Iterations(36000);
 BENCHMARK(BM_BuildSynthetic)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK_MAIN();

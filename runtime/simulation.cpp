@@ -7,6 +7,7 @@
 #include <initializer_list>
 #include <stdexcept>
 
+#include "runtime/det_math.hpp"
 #include "runtime/puppet.hpp"
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -50,6 +51,27 @@ void hash_gait(XXH64_state_t* h, const GaitState& g) {
     const float scalars[7] = {g.cycle_phase, g.speed, g.commanded_speed, g.run_blend, g.pelvis_base, g.lean, g.activity};
     hash_floats(h, scalars, 7);
     hash_ints(h, {static_cast<std::int32_t>(g.mode), g.turning_in_place, g.first_step, g.steps, g.flight_phases, g.flight_phases_open});
+}
+// The graph controller's state, field by field (gait-driven states skip it, so
+// their hashes are what they were before the graph existed).
+void hash_graph(XXH64_state_t* h, std::int32_t source, const GraphControllerState& g) {
+    hash_ints(h, {source, g.edge, static_cast<std::int32_t>(g.mode), g.last_buttons, g.action_label,
+                  g.action_path_length, g.action_path_next, g.search_depth, g.best_edge, g.contacts});
+    const double world[3] = {g.world_angle, g.world_dx, g.world_dz};
+    XXH64_update(h, world, sizeof world);
+    const float scalars[5] = {g.edge_position, g.idle_seconds, g.best_score, g.desired_vx, g.desired_vz};
+    hash_floats(h, scalars, 5);
+    const std::int64_t counters[5] = {g.decisions, g.transitions_taken, g.actions_played, g.nodes_expanded,
+                                      static_cast<std::int64_t>(g.rng)};
+    XXH64_update(h, counters, sizeof counters);
+    XXH64_update(h, g.action_path.data(), g.action_path.size() * sizeof(std::int32_t));
+    for (const GraphSearchLevel& l : g.search) {
+        hash_ints(h, {l.node, l.next_edge, l.first_edge});
+        const float f[2] = {l.seconds, l.cost};
+        hash_floats(h, f, 2);
+        const double w[3] = {l.angle, l.dx, l.dz};
+        XXH64_update(h, w, sizeof w);
+    }
 }
 }  // namespace
 
@@ -100,6 +122,50 @@ std::string Simulation::retune(const SimConfig& next) {
     return {};
 }
 
+void Simulation::use_motion_graph(std::shared_ptr<const MotionGraph> graph, const GraphControllerConfig& config,
+                                  double metres_per_unit) {
+    if (state_.tick != 0) throw std::invalid_argument("a motion graph can only be attached before the first tick");
+    if (!graph) throw std::invalid_argument("no motion graph given");
+    if (graph->joint_count() > kMaxJoints) throw std::invalid_argument("motion graph skeleton has too many joints");
+    if (!(metres_per_unit > 0.0)) throw std::invalid_argument("metres_per_unit must be positive");
+    auto controller = std::make_unique<GraphController>(*graph, config);  // validates the graph
+    const std::vector<std::uint8_t> bytes = serialize_motion_graph(*graph);
+    clip_data_hash_ ^= XXH64(bytes.data(), bytes.size(), 0x6D67726170680001ull);
+    graph_ = std::move(graph);
+    graph_controller_ = std::move(controller);
+    metres_per_unit_ = static_cast<float>(metres_per_unit);
+    state_.motion_source = 1;
+    state_.joint_count = graph_->joint_count();
+    state_.graph = graph_controller_->initial_state();
+    const size_t n = static_cast<size_t>(state_.joint_count);
+    graph_controller_->pose(state_.graph, std::span<quat>(state_.local_rotations.data(), n),
+                            std::span<vec3>(state_.local_translations.data(), n));
+    step_graph(TickInput{}, 0.0f);
+}
+
+void Simulation::step_graph(const TickInput& input, float dt) {
+    PuppetState& s = state_;
+    const size_t n = static_cast<size_t>(s.joint_count);
+    GraphControllerInput in;
+    in.stick_x = static_cast<float>(input.left_x) / kStickScale;
+    in.stick_y = static_cast<float>(input.left_y) / kStickScale;
+    in.buttons = input.buttons;
+    in.dt = dt;
+    const std::span<quat> local_r(s.local_rotations.data(), n);
+    const std::span<vec3> local_t(s.local_translations.data(), n);
+    if (dt > 0.0f) graph_controller_->step(s.graph, in, local_r, local_t);
+    for (size_t j = 0; j < n; ++j) s.local_translations[j] *= metres_per_unit_;
+    const LocalToModelJob fk{std::span<const int>(graph_->skeleton.parents), local_r, local_t,
+                             std::span<quat>(s.model_rotations.data(), n), std::span<vec3>(s.model_positions.data(), n)};
+    fk.run();
+    const vec3 root = s.model_positions[0];
+    const vec2 before(s.root_position.x, s.root_position.z);
+    s.root_position = vec3(root.x, 0.0f, root.z);
+    if (dt > 0.0f) s.velocity = (vec2(root.x, root.z) - before) / dt;
+    const vec3 forward = quat_rotate(s.model_rotations[0], vec3(0.0f, 0.0f, 1.0f));
+    s.heading = static_cast<float>(det::atan2(forward.x, forward.z));
+}
+
 void Simulation::pose_from_gait() {
     const size_t n = static_cast<size_t>(state_.joint_count);
     const GaitPoseJob job{&state_.gait,
@@ -121,6 +187,11 @@ void Simulation::step(const TickInput& input) {
     const float dt = 1.0f / static_cast<float>(c.tick_rate_hz);
     PuppetState& s = state_;
     s.input = input;
+    if (graph_controller_) {
+        step_graph(input, dt);
+        ++s.tick;
+        return;
+    }
 
     // The gait plans (stick → velocity, steps, pelvis); the pose comes from its state.
     GaitTickInput gait_input;
@@ -153,6 +224,7 @@ std::uint64_t hash_state(const PuppetState& s) {
     hash_floats(h, scalars, 8);
     hash_floats(h, &s.locomotion_blend, 1);
     hash_gait(h, s.gait);
+    if (s.motion_source != 0) hash_graph(h, s.motion_source, s.graph);
     const int n = s.joint_count < 0 ? 0 : (s.joint_count > kMaxJoints ? kMaxJoints : s.joint_count);
     for (int j = 0; j < n; ++j) {
         const size_t i = static_cast<size_t>(j);

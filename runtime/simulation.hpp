@@ -4,10 +4,12 @@
 // between threads, hashed field by field and compared bit for bit.
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "runtime/clip.hpp"
 #include "runtime/gait.hpp"
+#include "runtime/graph_controller.hpp"
 #include "runtime/sim_config.hpp"
 #include "runtime/terrain.hpp"
 #include "runtime/tick_input.hpp"
@@ -27,6 +29,8 @@ struct PuppetState {
     float idle_time = 0.0f;            // seconds into the idle clip
     float locomotion_blend = 0.0f;     // 0 idle … 1 walking
     GaitState gait{};                  // the spline-IK gait's plan (runtime/gait.hpp)
+    std::int32_t motion_source = 0;    // 0: the gait; 1: a motion graph (Simulation::use_motion_graph)
+    GraphControllerState graph{};      // the graph controller's state (hashed only when motion_source is 1)
     std::array<quat, kMaxJoints> local_rotations{};
     std::array<vec3, kMaxJoints> local_translations{};
     std::array<quat, kMaxJoints> model_rotations{};   // world space
@@ -56,13 +60,23 @@ public:
     const PuppetState& state() const { return state_; }
     const SimConfig& config() const { return config_; }
     const Terrain& terrain() const { return terrain_; }
-    const Skeleton& skeleton() const { return idle_clip_.skeleton; }
+    const Skeleton& skeleton() const { return graph_ ? graph_->skeleton : idle_clip_.skeleton; }
+
+    // Drives the puppet from a motion graph instead of the gait, from tick 0 (the
+    // graph's own skeleton is then the puppet's; its translations are scaled by
+    // metres_per_unit). The graph's content hash enters clip_data_hash(), so a log
+    // recorded with one graph refuses to replay with another. Throws
+    // std::invalid_argument after the first tick (a live switch needs the
+    // cross-fade, not implemented) or for a graph the controller refuses.
+    void use_motion_graph(std::shared_ptr<const MotionGraph> graph, const GraphControllerConfig& config,
+                          double metres_per_unit);
     double tick_seconds() const { return 1.0 / config_.tick_rate_hz; }
     // Hash of the clip data the puppet animates, recorded in input logs.
     std::uint64_t clip_data_hash() const { return clip_data_hash_; }
 
 private:
     void pose_from_gait();
+    void step_graph(const TickInput& input, float dt);
 
     SimConfig config_;
     Terrain terrain_;
@@ -70,6 +84,9 @@ private:
     Clip walk_clip_;
     std::uint64_t clip_data_hash_ = 0;
     GaitRig rig_;
+    std::shared_ptr<const MotionGraph> graph_;
+    std::unique_ptr<GraphController> graph_controller_;
+    float metres_per_unit_ = 1.0f;
     PuppetState state_;
 };
 
