@@ -4,6 +4,7 @@
 #include "app/cli.hpp"
 #include "app/commands.hpp"
 #include "app/config.hpp"
+#include "app/default_graph.hpp"
 #include "app/files.hpp"
 #include "app/graph_files.hpp"
 #include "app/json.hpp"
@@ -11,6 +12,16 @@
 #include "app/replay.hpp"
 
 namespace marionette {
+
+namespace {
+// --graph FILE.mgraph, or "default": the embedded default graph, built from the
+// configuration's [motion_graph] parameters (identical bytes every time, so a
+// log recorded with it replays with it).
+std::shared_ptr<const MotionGraph> graph_from_argument(const std::string& argument, const SimConfig& config) {
+    if (argument == "default") return std::make_shared<const MotionGraph>(build_default_motion_graph(config));
+    return std::make_shared<const MotionGraph>(load_motion_graph_file(argument));
+}
+}  // namespace
 
 int record_command(const RecordOptions& o) {
     const SimConfig config = load_config(o.config_file);
@@ -20,7 +31,7 @@ int record_command(const RecordOptions& o) {
     set_simulation_float_mode();
     Simulation sim(config);
     if (!o.graph_file.empty())
-        attach_motion_graph(sim, std::make_shared<const MotionGraph>(load_motion_graph_file(o.graph_file)));
+        attach_motion_graph(sim, graph_from_argument(o.graph_file, config));
     InputLogHeader header;
     header.tick_rate_hz = static_cast<std::uint32_t>(config.tick_rate_hz);
     header.clip_data_hash = sim.clip_data_hash();
@@ -52,7 +63,9 @@ int replay_command(const ReplayCommandOptions& o) {
     options.trace_csv = o.trace_csv;
     options.joints_csv = o.joints_csv;
     options.bvh = o.bvh;
-    if (!o.graph_file.empty()) options.graph = std::make_shared<const MotionGraph>(load_motion_graph_file(o.graph_file));
+    if (!o.graph_file.empty())
+        options.graph = graph_from_argument(
+            o.graph_file, config_from_text(log.header.config_text, o.log_file + " (embedded configuration)"));
     const ReplayResult r = replay_log(log, o.log_file, options);
     if (o.json) {
         fmt::print("{{\"log\":{},\"ticks\":{},\"tick_rate_hz\":{},\"duration_s\":{},\"final_hash\":\"{:016x}\","
@@ -78,7 +91,7 @@ void register_log_commands(CLI::App& app, int& exit_code) {
     record->add_option("--config", rec->config_file, "TOML file overriding the defaults")->check(CLI::ExistingFile);
     record->add_option("--chunk-ticks", rec->chunk_ticks, "ticks per log chunk")->check(CLI::Range(1u, 1u << 20));
     record->add_flag("--json", rec->json, "print a JSON summary");
-    record->add_option("--graph", rec->graph_file, "drive the puppet from this motion graph (.mgraph)");
+    record->add_option("--graph", rec->graph_file, "drive the puppet from this motion graph (.mgraph, or default: the embedded one)");
     on_parsed(record, exit_code, [rec] { return record_command(*rec); });
 
     auto rep = std::make_shared<ReplayCommandOptions>();
@@ -89,7 +102,7 @@ void register_log_commands(CLI::App& app, int& exit_code) {
     replay->add_option("--joints-csv", rep->joints_csv, "per-tick CSV of every joint's world position");
     replay->add_option("--bvh", rep->bvh, "export the performed motion as BVH");
     replay->add_flag("--json", rep->json, "print a JSON summary");
-    replay->add_option("--graph", rep->graph_file, "the motion graph (.mgraph) the log was recorded with");
+    replay->add_option("--graph", rep->graph_file, "the motion graph (.mgraph, or default) the log was recorded with");
     on_parsed(replay, exit_code, [rep] { return replay_command(*rep); });
 }
 
