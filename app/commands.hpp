@@ -17,6 +17,7 @@ struct RunOptions {
     double duration_s = -1.0;                // < 0: until the input ends
     std::vector<double> unplug;              // pairs: at, for (seconds), simulated controller only
     bool fast = false;                       // no real-time pacing: virtual time
+    std::string graph_file;                  // --graph: drive the puppet from this .mgraph (or default)
 };
 int run_command(const RunOptions& options);
 

@@ -1,5 +1,6 @@
 #include "app/graph_files.hpp"
 
+#include "app/default_graph.hpp"
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -33,6 +34,11 @@ graph::GraphBuildParams graph_build_params(const SimConfig& c) {
     p.contact_height = c.graph_contact_height;
     p.contact_speed = c.graph_contact_speed;
     return p;
+}
+
+std::shared_ptr<const MotionGraph> load_graph_argument(const std::string& argument, const SimConfig& config) {
+    if (argument == "default") return std::make_shared<const MotionGraph>(build_default_motion_graph(config));
+    return std::make_shared<const MotionGraph>(load_motion_graph_file(argument));
 }
 
 void attach_motion_graph(Simulation& sim, std::shared_ptr<const MotionGraph> graph) {

@@ -4,7 +4,6 @@
 #include "app/cli.hpp"
 #include "app/commands.hpp"
 #include "app/config.hpp"
-#include "app/default_graph.hpp"
 #include "app/files.hpp"
 #include "app/graph_files.hpp"
 #include "app/json.hpp"
@@ -12,16 +11,6 @@
 #include "app/replay.hpp"
 
 namespace marionette {
-
-namespace {
-// --graph FILE.mgraph, or "default": the embedded default graph, built from the
-// configuration's [motion_graph] parameters (identical bytes every time, so a
-// log recorded with it replays with it).
-std::shared_ptr<const MotionGraph> graph_from_argument(const std::string& argument, const SimConfig& config) {
-    if (argument == "default") return std::make_shared<const MotionGraph>(build_default_motion_graph(config));
-    return std::make_shared<const MotionGraph>(load_motion_graph_file(argument));
-}
-}  // namespace
 
 int record_command(const RecordOptions& o) {
     const SimConfig config = load_config(o.config_file);
@@ -31,7 +20,7 @@ int record_command(const RecordOptions& o) {
     set_simulation_float_mode();
     Simulation sim(config);
     if (!o.graph_file.empty())
-        attach_motion_graph(sim, graph_from_argument(o.graph_file, config));
+        attach_motion_graph(sim, load_graph_argument(o.graph_file, config));
     InputLogHeader header;
     header.tick_rate_hz = static_cast<std::uint32_t>(config.tick_rate_hz);
     header.clip_data_hash = sim.clip_data_hash();
@@ -64,7 +53,7 @@ int replay_command(const ReplayCommandOptions& o) {
     options.joints_csv = o.joints_csv;
     options.bvh = o.bvh;
     if (!o.graph_file.empty())
-        options.graph = graph_from_argument(
+        options.graph = load_graph_argument(
             o.graph_file, config_from_text(log.header.config_text, o.log_file + " (embedded configuration)"));
     const ReplayResult r = replay_log(log, o.log_file, options);
     if (o.json) {

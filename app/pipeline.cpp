@@ -13,6 +13,7 @@
 #include "app/config.hpp"
 #include "app/config_watcher.hpp"
 #include "app/files.hpp"
+#include "app/graph_files.hpp"
 #include "app/realtime.hpp"
 #include "app/replay.hpp"
 #include "input/input_thread.hpp"
@@ -466,6 +467,7 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
     // Everything that allocates happens here, before the threads start.
     set_simulation_float_mode();
     auto loop = std::make_unique<SimulationLoop>(config, sh, o.scheduled_changes, o.virtual_time);
+    if (o.graph) attach_motion_graph(loop->simulation_before_start(), o.graph);
     std::unique_ptr<InputLogFile> log;
     if (!o.record_file.empty()) {
         InputLogHeader header;

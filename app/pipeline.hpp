@@ -22,6 +22,7 @@
 #include "runtime/input_log.hpp"
 #include "runtime/latency_histogram.hpp"
 #include "runtime/latest_value.hpp"
+#include "runtime/motion_graph.hpp"
 #include "runtime/simulation.hpp"
 #include "runtime/spsc_ring.hpp"
 #include "runtime/stick_program.hpp"
@@ -117,6 +118,8 @@ public:
     void run_tick(std::int64_t tick_time_ns, std::int64_t now_ns);
 
     const Simulation& simulation() const { return sim_; }
+    // Before the first tick only (Simulation::use_motion_graph).
+    Simulation& simulation_before_start() { return sim_; }
     const TickInputAssembler& assembler() const { return assembler_; }
     const InputLatencyHistogram& input_latency() const { return latency_; }
     std::uint64_t config_changes() const { return config_changes_; }
@@ -207,6 +210,7 @@ struct PipelineOptions {
     const input::InputThreadOptions* device = nullptr;
     std::vector<ScheduledConfigChange> scheduled_changes;
     std::uint64_t total_ticks = 0;
+    std::shared_ptr<const MotionGraph> graph;  // drive the puppet from this graph (null: the gait)
     // No clock: ticks run as fast as the input thread provides samples, each tick
     // waiting for every sample up to its time, so the run is deterministic.
     bool virtual_time = false;

@@ -13,6 +13,7 @@
 #include "app/commands.hpp"
 #include "app/config.hpp"
 #include "app/files.hpp"
+#include "app/graph_files.hpp"
 #include "app/json.hpp"
 #include "app/pipeline.hpp"
 #include "app/program_source.hpp"
@@ -190,6 +191,7 @@ int run_command(const RunOptions& o) {
     if (o.duration_s >= 0.0) p.total_ticks = static_cast<std::uint64_t>(o.duration_s * config.tick_rate_hz + 0.5);
 
     p.config = config;
+    if (!o.graph_file.empty()) p.graph = load_graph_argument(o.graph_file, config);
     p.virtual_time = o.fast;
     p.record_file = o.record_file;
     p.trace_file = o.trace_file;
@@ -256,6 +258,7 @@ void register_run_command(CLI::App& app, int& exit_code) {
         ->check(CLI::IsMember({"auto", "headless", "kms", "window"}));
     cmd->add_option("--record", o->record_file, "write the input log here");
     cmd->add_option("--trace", o->trace_file, "per-tick CSV: tick,hash,root_x,root_y,root_z (as replay --trace)");
+    cmd->add_option("--graph", o->graph_file, "drive the puppet from this motion graph (.mgraph, or default: the embedded one)");
     cmd->add_option("--stats-json", o->stats_json, "write the run's statistics here as JSON");
     cmd->add_option("--duration", o->duration_s, "seconds to run (default: until the input ends)")
         ->check(CLI::Range(0.0, 86400.0));
