@@ -70,6 +70,13 @@ const KeySpec kKeys[] = {
     {"motion_graph", "contact_height", &SimConfig::graph_contact_height, 0.0, 1.0, "foot contact: height above the clip's ground, leg lengths"},
     {"motion_graph", "contact_speed", &SimConfig::graph_contact_speed, 0.0, 10.0, "foot contact: ground-plane speed, leg lengths per second"},
     {"motion_graph", "transition_weight", &SimConfig::graph_transition_weight, 0.0, 1000.0, "path cost: seconds charged per unit of transition distance"},
+    {"motion_graph", "horizon_s", &SimConfig::graph_horizon_s, 0.1, 10.0, "controller: look-ahead of the stick-following search (s)"},
+    {"motion_graph", "max_nodes_per_tick", &SimConfig::graph_max_nodes_per_tick, 1, 100000, "controller: search nodes expanded per tick at most"},
+    {"motion_graph", "full_stick_speed", &SimConfig::graph_full_stick_speed, 0.1, 20.0, "controller: speed asked for at full stick (leg lengths per second)"},
+    {"motion_graph", "leg_metres", &SimConfig::graph_leg_metres, 0.1, 5.0, "the graph's leg length is scaled to this (m)"},
+    {"motion_graph", "attract_after_s", &SimConfig::graph_attract_after_s, 0.1, 86400.0, "seconds without input before the attract-mode random walk"},
+    {"motion_graph", "attract_temperature", &SimConfig::graph_attract_temperature, 0.001, 1000.0, "attract walk: edge weight 1 / (1 + cost / temperature)"},
+    {"motion_graph", "attract_seed", &SimConfig::graph_attract_seed, 0, 2147483647, "attract-mode random seed"},
     // [gait] (docs/gait.md); the prototypes are [gait.walk] and [gait.run], below.
     {"gait", "pelvis_height", &SimConfig::gait_pelvis_height, 0.3, 2.0, "hip height above the mean foot ground while stepping (m)"},
     {"gait", "step_length_multiplier", &SimConfig::step_length_multiplier, 0.05, 2.0, "step length = multiplier · sqrt(speed)"},

@@ -42,12 +42,19 @@ std::shared_ptr<const MotionGraph> load_graph_argument(const std::string& argume
 }
 
 void attach_motion_graph(Simulation& sim, std::shared_ptr<const MotionGraph> graph) {
+    const SimConfig& sim_config = sim.config();
     GraphControllerConfig config;
     const double leg = graph->leg_length > 0.0f ? graph->leg_length : 1.0;
-    config.max_speed = 1.5 * leg;
+    config.horizon_s = sim_config.graph_horizon_s;
+    config.max_nodes_per_tick = sim_config.graph_max_nodes_per_tick;
+    config.max_speed = sim_config.graph_full_stick_speed * leg;
+    config.transition_weight = sim_config.graph_transition_weight;
+    config.attract_after_s = sim_config.graph_attract_after_s;
+    config.attract_temperature = sim_config.graph_attract_temperature;
+    config.seed = static_cast<std::uint64_t>(sim_config.graph_attract_seed);
     const char* const labels[4] = {"jump", "wave", "bow", "look_around"};
     for (int b = 0; b < 4; ++b) config.button_label[static_cast<size_t>(b)] = graph->label_index(labels[b]);
-    sim.use_motion_graph(std::move(graph), config, 0.9 / leg);
+    sim.use_motion_graph(std::move(graph), config, sim_config.graph_leg_metres / leg);
 }
 
 }  // namespace marionette

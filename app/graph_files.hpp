@@ -21,9 +21,9 @@ std::shared_ptr<const MotionGraph> load_graph_argument(const std::string& argume
 void write_binary_file(const std::string& path, const std::vector<std::uint8_t>& bytes);
 graph::GraphBuildParams graph_build_params(const SimConfig& config);
 
-// Drives `sim` from `graph` (`--graph` on record/replay): the controller's
-// defaults, full stick = 1.5 leg lengths per second, the graph scaled so a leg
-// is 0.9 m, and the face buttons south/east/west/north mapped to the labels
+// Drives `sim` from `graph` (`--graph` on record, replay and run): the
+// controller's settings from the simulation's [motion_graph] keys (horizon, nodes
+// per tick, full-stick speed, leg scale, attract mode), and the face buttons south/east/west/north mapped to the labels
 // jump/wave/bow/look_around where the graph has them.
 void attach_motion_graph(Simulation& sim, std::shared_ptr<const MotionGraph> graph);
 

@@ -85,6 +85,14 @@ struct SimConfig {
     float graph_contact_height = 0.08f;           // foot contact: height above ground, leg lengths
     float graph_contact_speed = 0.6f;             // foot contact: speed, leg lengths per second
     float graph_transition_weight = 1.0f;         // path cost: seconds per unit of transition distance
+    // [motion_graph] the run-time controller (runtime/graph_controller.hpp)
+    float graph_horizon_s = 1.0f;                 // look-ahead of the stick-following search
+    std::int32_t graph_max_nodes_per_tick = 64;   // search nodes expanded per tick at most
+    float graph_full_stick_speed = 1.5f;          // leg lengths per second at full stick
+    float graph_leg_metres = 0.9f;                // the graph's leg is scaled to this many metres
+    float graph_attract_after_s = 30.0f;          // seconds without input before the attract-mode walk
+    float graph_attract_temperature = 1.0f;       // attract walk: edge weight 1 / (1 + cost / temperature)
+    std::int32_t graph_attract_seed = 1;          // attract-mode PRNG seed
 };
 
 }  // namespace marionette
