@@ -275,6 +275,15 @@ __attribute__((noinline)) void add_row(float* __restrict dst, const float* __res
     for (std::int32_t c = 0; c < n; ++c) dst[c] += src[c];
 }
 
+// out[r][c] = row (a_first + r) of `a` · row (b_first + c) of `b`, r < a_rows,
+// c < b_rows, rows `width` floats long: every cross term of a tile is one sgemm.
+void row_dots(const float* a, std::int32_t a_first, std::int32_t a_rows, const float* b, std::int32_t b_first,
+              std::int32_t b_rows, int width, float* out) {
+    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, a_rows, b_rows, width, 1.0f,
+                a + static_cast<size_t>(a_first) * static_cast<size_t>(width), width,
+                b + static_cast<size_t>(b_first) * static_cast<size_t>(width), width, 0.0f, out, b_rows);
+}
+
 struct TileScratch {
     std::vector<float> ca, cb, cy;        // per-frame cross terms of the tile
     std::vector<float> sa, sb, sy;        // one row of k-frame diagonal window sums
@@ -304,25 +313,16 @@ void run_tile(const FrameFeatures& f, const CandidateSearchOptions& o, std::int3
     s.cb.resize(cells);
     s.cy.resize(cells);
     // Cross terms of every frame pair of the tile: C[r][c] = frame (row0+r) · frame (col0+c).
-    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, nr, nc, width, 1.0f,
-                f.xz.data() + static_cast<size_t>(row0) * static_cast<size_t>(width), width,
-                f.xz.data() + static_cast<size_t>(col0) * static_cast<size_t>(width), width, 0.0f, s.ca.data(), nc);
-    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, nr, nc, width, 1.0f,
-                f.xz.data() + static_cast<size_t>(row0) * static_cast<size_t>(width), width,
-                f.zx.data() + static_cast<size_t>(col0) * static_cast<size_t>(width), width, 0.0f, s.cb.data(), nc);
-    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, nr, nc, J, 1.0f, f.y.data() + static_cast<size_t>(row0) * static_cast<size_t>(J), J,
-                f.y.data() + static_cast<size_t>(col0) * static_cast<size_t>(J), J, 0.0f, s.cy.data(), nc);
+    row_dots(f.xz.data(), row0, nr, f.xz.data(), col0, nc, width, s.ca.data());
+    row_dots(f.xz.data(), row0, nr, f.zx.data(), col0, nc, width, s.cb.data());
+    row_dots(f.y.data(), row0, nr, f.y.data(), col0, nc, J, s.cy.data());
 
     const std::int32_t dr = ei1 - ei0, dc = ej1 - ej0;
     const int w2 = 2 * k;
     s.wa.resize(static_cast<size_t>(dr) * static_cast<size_t>(dc));
     s.wb.resize(static_cast<size_t>(dr) * static_cast<size_t>(dc));
-    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, dr, dc, w2, 1.0f,
-                f.window_dot.data() + static_cast<size_t>(ei0) * static_cast<size_t>(w2), w2,
-                f.window_dot.data() + static_cast<size_t>(col0) * static_cast<size_t>(w2), w2, 0.0f, s.wa.data(), dc);
-    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, dr, dc, w2, 1.0f,
-                f.window_dot.data() + static_cast<size_t>(ei0) * static_cast<size_t>(w2), w2,
-                f.window_cross.data() + static_cast<size_t>(col0) * static_cast<size_t>(w2), w2, 0.0f, s.wb.data(), dc);
+    row_dots(f.window_dot.data(), ei0, dr, f.window_dot.data(), col0, dc, w2, s.wa.data());
+    row_dots(f.window_dot.data(), ei0, dr, f.window_cross.data(), col0, dc, w2, s.wb.data());
 
     // Window sums: pair (i, j) needs Σ_t C[r+t][c+t] with r = i − ei0, c = j − ej0
     // (its k cells along one diagonal). Row by row, adding the k shifted rows is
