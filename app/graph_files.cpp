@@ -1,11 +1,11 @@
 #include "app/graph_files.hpp"
 
-#include "app/default_graph.hpp"
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <stdexcept>
 
+#include "app/default_graph.hpp"
 #include "app/files.hpp"
 
 namespace marionette {
