@@ -37,6 +37,12 @@ graph::GraphBuildParams graph_build_params(const SimConfig& c) {
 }
 
 std::shared_ptr<const MotionGraph> load_graph_argument(const std::string& argument, const SimConfig& config) {
+    if (argument.empty()) {
+        const bool wants_graph = config.motion_source == MotionSourceSetting::graph ||
+                                 config.motion_source == MotionSourceSetting::graph_feet;
+        if (!wants_graph) return nullptr;
+        return std::make_shared<const MotionGraph>(build_default_motion_graph(config));
+    }
     if (argument == "default") return std::make_shared<const MotionGraph>(build_default_motion_graph(config));
     return std::make_shared<const MotionGraph>(load_motion_graph_file(argument));
 }
@@ -54,7 +60,12 @@ void attach_motion_graph(Simulation& sim, std::shared_ptr<const MotionGraph> gra
     config.seed = static_cast<std::uint64_t>(sim_config.graph_attract_seed);
     const char* const labels[4] = {"jump", "wave", "bow", "look_around"};
     for (int b = 0; b < 4; ++b) config.button_label[static_cast<size_t>(b)] = graph->label_index(labels[b]);
-    sim.use_motion_graph(std::move(graph), config, sim_config.graph_leg_metres / leg);
+    // A graph of the puppet's own skeleton (the default graph) is in the puppet's
+    // metres already; any other is scaled so its leg is leg_metres long.
+    const Skeleton& puppet = sim.skeleton();
+    const bool puppet_skeleton = graph->skeleton.joint_names == puppet.joint_names && graph->skeleton.parents == puppet.parents;
+    const double metres_per_unit = puppet_skeleton ? 1.0 : sim_config.graph_leg_metres / leg;
+    sim.use_motion_graph(std::move(graph), config, metres_per_unit);
 }
 
 }  // namespace marionette

@@ -17,6 +17,8 @@ MotionGraph load_motion_graph_file(const std::string& path);
 // `--graph` on record, replay and run: a .mgraph file, or "default" for the
 // embedded default graph built from the configuration's [motion_graph]
 // parameters (identical bytes every time, so a log recorded with it replays with it).
+// An empty argument gives the default graph when the configuration's [motion]
+// source is graph or graph_feet, and no graph (nullptr) otherwise.
 std::shared_ptr<const MotionGraph> load_graph_argument(const std::string& argument, const SimConfig& config);
 void write_binary_file(const std::string& path, const std::vector<std::uint8_t>& bytes);
 graph::GraphBuildParams graph_build_params(const SimConfig& config);

@@ -19,8 +19,7 @@ int record_command(const RecordOptions& o) {
 
     set_simulation_float_mode();
     Simulation sim(config);
-    if (!o.graph_file.empty())
-        attach_motion_graph(sim, load_graph_argument(o.graph_file, config));
+    if (auto graph = load_graph_argument(o.graph_file, config)) attach_motion_graph(sim, std::move(graph));
     InputLogHeader header;
     header.tick_rate_hz = static_cast<std::uint32_t>(config.tick_rate_hz);
     header.clip_data_hash = sim.clip_data_hash();
@@ -52,9 +51,8 @@ int replay_command(const ReplayCommandOptions& o) {
     options.trace_csv = o.trace_csv;
     options.joints_csv = o.joints_csv;
     options.bvh = o.bvh;
-    if (!o.graph_file.empty())
-        options.graph = load_graph_argument(
-            o.graph_file, config_from_text(log.header.config_text, o.log_file + " (embedded configuration)"));
+    options.graph = load_graph_argument(
+        o.graph_file, config_from_text(log.header.config_text, o.log_file + " (embedded configuration)"));
     const ReplayResult r = replay_log(log, o.log_file, options);
     if (o.json) {
         fmt::print("{{\"log\":{},\"ticks\":{},\"tick_rate_hz\":{},\"duration_s\":{},\"final_hash\":\"{:016x}\","

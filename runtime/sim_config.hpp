@@ -10,6 +10,10 @@
 
 namespace marionette {
 
+// [motion] source: what poses the puppet. `automatic` is the motion graph when one
+// is attached (`--graph`), the gait otherwise.
+enum class MotionSourceSetting : std::int32_t { automatic = 0, gait = 1, graph = 2, graph_feet = 3 };
+
 struct SimConfig {
     // [simulation]
     std::int32_t tick_rate_hz = 240;
@@ -93,6 +97,12 @@ struct SimConfig {
     float graph_attract_after_s = 30.0f;          // seconds without input before the attract-mode walk
     float graph_attract_temperature = 1.0f;       // attract walk: edge weight 1 / (1 + cost / temperature)
     std::int32_t graph_attract_seed = 1;          // attract-mode PRNG seed
+    // [motion] which source poses the puppet, and how a change of source blends
+    // (docs/motion-graph.md, "Motion sources")
+    MotionSourceSetting motion_source = MotionSourceSetting::automatic;
+    float motion_crossfade_s = 0.4f;              // a live change of source cross-fades over this long
+    float feet_release_s = 0.15f;                 // graph_feet: a lifted foot eases from its pin back to the clip
+    float feet_terrain_rate = 10.0f;              // graph_feet: 1/s the body follows the ground height
 };
 
 }  // namespace marionette
