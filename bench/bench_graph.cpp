@@ -2,6 +2,8 @@
 //   build/release/bench/marionette_bench_graph
 // MARIONETTE_MOCAP_DIR (default ../shared/data/mocap) holds the CMU clips;
 // MARIONETTE_BENCH_FRAMES sets the synthetic database size (default 100000).
+// `--benchmark_filter=Controller` runs only the controller (circle, and circle
+// with action presses on the default graph and CMU-16).
 // Reports, per build: seconds, pair evaluations per second, peak RSS; for the
 // reference comparison: both times, the speed-up and whether the candidates agree.
 #include <benchmark/benchmark.h>
@@ -12,6 +14,7 @@
 #include <cstdlib>
 #include <random>
 
+#include "app/default_graph.hpp"
 #include "motion_graph/graph_builder.hpp"
 #include "runtime/det_math.hpp"
 #include "runtime/graph_controller.hpp"
@@ -229,8 +232,75 @@ void BM_ControllerCircleCmu16(benchmark::State& state) {
     state.counters["transitions"] = static_cast<double>(s.transitions_taken);
 }
 
+// The controller following the same circle while the face buttons south, east,
+// west, north are pressed in turn every 3 s (100 ms each), at the simulation's
+// 240 Hz: every tick, and separately the ticks where an action path query was
+// being sliced (mode find_action, or the tick that finished it).
+void controller_circle_actions(benchmark::State& state, const MotionGraph& g) {
+    GraphControllerConfig config;
+    config.max_speed = 1.5 * g.leg_length;
+    config.max_nodes_per_tick = static_cast<int>(state.range(0));
+    const char* const labels[4] = {"jump", "wave", "bow", "look_around"};
+    const char* const fallback[4] = {"walk", "run", "turn", "stop"};  // CMU-16 has no action clips
+    for (int b = 0; b < 4; ++b) {
+        const int l = g.label_index(labels[b]);
+        config.button_label[static_cast<size_t>(b)] = l >= 0 ? l : g.label_index(fallback[b]);
+    }
+    GraphController controller(g, config);
+    GraphControllerState s = controller.initial_state();
+    std::vector<quat> r(static_cast<size_t>(g.joint_count()));
+    std::vector<vec3> t(static_cast<size_t>(g.joint_count()));
+    std::vector<double> micros, query_micros;
+    micros.reserve(1 << 20), query_micros.reserve(1 << 20);
+    std::int64_t tick = 0, presses = 0;
+    constexpr int kHz = 240;
+    for (auto _ : state) {
+        GraphControllerInput in;
+        in.dt = 1.0f / kHz;
+        const double a = 0.5 * static_cast<double>(tick) / kHz;
+        in.stick_x = static_cast<float>(det::sin(a));
+        in.stick_y = static_cast<float>(-det::cos(a));
+        const std::int64_t phase = tick % (3 * kHz);
+        if (phase >= kHz && phase < kHz + kHz / 10) in.buttons = static_cast<std::uint16_t>(1u << ((tick / (3 * kHz)) % 4));
+        presses += phase == kHz;
+        ++tick;
+        const bool querying = s.mode == GraphMotionMode::find_action || (in.buttons != 0 && s.mode == GraphMotionMode::locomotion);
+        const auto t0 = std::chrono::steady_clock::now();
+        controller.step(s, in, r, t);
+        const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
+        micros.push_back(us);
+        if (querying) query_micros.push_back(us);
+        benchmark::DoNotOptimize(r.data());
+    }
+    std::sort(micros.begin(), micros.end());
+    std::sort(query_micros.begin(), query_micros.end());
+    state.counters["median_us"] = micros[micros.size() / 2];
+    state.counters["p99_us"] = micros[micros.size() * 99 / 100];
+    state.counters["max_us"] = micros.back();
+    if (!query_micros.empty()) {
+        state.counters["query_ticks"] = static_cast<double>(query_micros.size());
+        state.counters["query_median_us"] = query_micros[query_micros.size() / 2];
+        state.counters["query_max_us"] = query_micros.back();
+    }
+    state.counters["presses"] = static_cast<double>(presses);
+    state.counters["actions_played"] = static_cast<double>(s.actions_played);
+    state.counters["transitions"] = static_cast<double>(s.transitions_taken);
+}
+
+void BM_ControllerCircleActionsCmu16(benchmark::State& state) {
+    static const GraphBuildOutput out = build_motion_graph(cmu16(), GraphBuildParams{});
+    controller_circle_actions(state, out.graph);
+}
+
+void BM_ControllerCircleActionsDefault(benchmark::State& state) {
+    static const MotionGraph g = build_default_motion_graph(SimConfig{});
+    controller_circle_actions(state, g);
+}
+
 }  // namespace
 
+BENCHMARK(BM_ControllerCircleActionsDefault)->Arg(64)->Unit(benchmark::kMicrosecond)->Iterations(240 * 150);
+BENCHMARK(BM_ControllerCircleActionsCmu16)->Arg(64)->Unit(benchmark::kMicrosecond)->Iterations(240 * 150);
 BENCHMARK(BM_BuildCmu16)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_ReferenceSpeedup)->Arg(1000)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_PathQuery)->Unit(benchmark::kMicrosecond);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -59,7 +60,54 @@ std::vector<float> seconds_to_goals(const MotionGraph& g, const std::vector<char
     for (size_t i = 0; i < n; ++i) out[i] = static_cast<float>(best[i]);
     return out;
 }
+
+int root_joint_of(const MotionGraph& g) {
+    for (size_t j = 0; j < g.skeleton.parents.size(); ++j)
+        if (g.skeleton.parents[j] == kNoParent) return static_cast<int>(j);
+    return 0;
+}
 }  // namespace
+
+double estimate_graph_facing(const MotionGraph& g, int* samples, double* agreement) {
+    const size_t joints = static_cast<size_t>(g.joint_count());
+    const size_t root = static_cast<size_t>(root_joint_of(g));
+    const int walk = g.label_index("walk");
+    // Travel over about a quarter second: long enough to average out the sway of a step.
+    const int step = std::max(1, static_cast<int>(g.frame_rate / 4.0));
+    double sum_sin = 0.0, sum_cos = 0.0, weight = 0.0;
+    int used = 0;
+    for (const GraphClip& clip : g.clips) {
+        if (walk >= 0 && !((clip.label_mask >> walk) & 1u)) continue;
+        const auto at = [&](int f) { return static_cast<size_t>(clip.first_frame + f) * joints + root; };
+        double top = 0.0;
+        for (int f = 0; f + step < clip.frame_count; ++f) {
+            const vec3 d = g.translations[at(f + step)] - g.translations[at(f)];
+            top = std::max(top, std::sqrt(static_cast<double>(d.x) * d.x + static_cast<double>(d.z) * d.z));
+        }
+        if (!(top > 0.0)) continue;
+        for (int f = 0; f + step < clip.frame_count; ++f) {
+            const vec3 d = g.translations[at(f + step)] - g.translations[at(f)];
+            const double length = std::sqrt(static_cast<double>(d.x) * d.x + static_cast<double>(d.z) * d.z);
+            if (length < 0.4 * top) continue;
+            const vec3 forward = quat_rotate(g.rotations[at(f)], vec3(0.0f, 0.0f, 1.0f));
+            const double facing = det::atan2(forward.x, forward.z);
+            const double travel = det::atan2(d.x, d.z);
+            const double angle = det::wrap_angle(travel - facing);
+            sum_sin += length * det::sin(angle), sum_cos += length * det::cos(angle);
+            weight += length;
+            ++used;
+        }
+    }
+    const double resultant = weight > 0.0 ? std::sqrt(sum_sin * sum_sin + sum_cos * sum_cos) / weight : 0.0;
+    if (samples) *samples = used;
+    if (agreement) *agreement = resultant;
+    if (used == 0 || resultant < 0.5) return 0.0;
+    const double mean = det::atan2(sum_sin, sum_cos);
+    const double quarter = det::kHalfPi;
+    const double axis = std::nearbyint(mean / quarter) * quarter;
+    const double snapped = std::abs(mean - axis) <= 15.0 * det::kPi / 180.0 ? axis : mean;
+    return det::wrap_angle(snapped);
+}
 
 GraphController::GraphController(const MotionGraph& graph, const GraphControllerConfig& config)
     : graph_(graph), config_(config), path_search_(graph, config.transition_weight) {
@@ -73,12 +121,11 @@ GraphController::GraphController(const MotionGraph& graph, const GraphController
     rot_a_.resize(joints), rot_b_.resize(joints), tra_a_.resize(joints), tra_b_.resize(joints);
     const size_t frames = graph.contacts.size();
     frame_yaw_.resize(frames);
-    int root = 0;
-    for (size_t j = 0; j < joints; ++j)
-        if (graph.skeleton.parents[j] == kNoParent) { root = static_cast<int>(j); break; }
+    const int root = root_joint_of(graph);
+    facing_offset_ = estimate_graph_facing(graph);
     for (size_t f = 0; f < frames; ++f) {
         const vec3 forward = quat_rotate(graph.rotations[f * joints + static_cast<size_t>(root)], vec3(0.0f, 0.0f, 1.0f));
-        frame_yaw_[f] = static_cast<float>(det::atan2(forward.x, forward.z));
+        frame_yaw_[f] = static_cast<float>(det::wrap_angle(det::atan2(forward.x, forward.z) + facing_offset_));
     }
     // Ground speed of the root at each node's frame (over the next frame of its clip).
     std::vector<char> moving(graph.nodes.size(), 0), still(graph.nodes.size(), 0);
@@ -96,6 +143,12 @@ GraphController::GraphController(const MotionGraph& graph, const GraphController
     }
     seconds_to_moving_ = seconds_to_goals(graph, moving, config.transition_weight);
     seconds_to_still_ = seconds_to_goals(graph, still, config.transition_weight);
+}
+
+void GraphController::set_config(const GraphControllerConfig& config) {
+    config_ = config;
+    path_search_.set_transition_weight(config.transition_weight);
+    path_search_label_ = -1;  // the scratch no longer matches any state
 }
 
 int GraphController::clip_edge_of(int node) const {
@@ -291,11 +344,49 @@ int GraphController::choose_next_edge(GraphControllerState& s) {
         ++s.actions_played;
     }
     if (s.mode == GraphMotionMode::attract) return random_edge(s);
+    if (s.mode == GraphMotionMode::find_action) {
+        // The edge ends before the path query did: give it what is left of this
+        // tick's budget, as the look-ahead gets below.
+        advance_action_search(s, config_.max_nodes_per_tick);
+        if (s.mode == GraphMotionMode::to_action) return choose_next_edge(s);
+    }
     // Locomotion: finish the look-ahead with what is left of this tick's budget; the best so far otherwise.
     if (s.search_depth >= 0) search_run(s, config_.max_nodes_per_tick);
     if (s.best_edge >= 0 && graph_.edges[static_cast<size_t>(s.best_edge)].from == node) return s.best_edge;
     const int clip = clip_edge_of(node);
     return clip >= 0 ? clip : graph_.edge_index(graph_.out_edges(node)[0]);
+}
+
+// Slices the action path query on by at most `budget` heap pops. The scratch is
+// first made the pure function of the state it must be (start node = end of the
+// edge, label, pops so far), re-deriving it when it belongs to another state.
+void GraphController::advance_action_search(GraphControllerState& s, int budget) {
+    const int from = graph_.edges[static_cast<size_t>(s.edge)].to;
+    const bool same_query = path_search_label_ == s.action_label && path_search_.start() == from &&
+                            path_search_.status() == PathSearchStatus::running;
+    if (!same_query || path_search_.pops() > s.action_search_pops) {
+        path_search_.clear_goals();
+        path_search_.add_label_goal(s.action_label);
+        path_search_.begin(from);
+        path_search_label_ = s.action_label;
+    }
+    if (path_search_.pops() < s.action_search_pops) path_search_.advance(s.action_search_pops - path_search_.pops());
+    const PathSearchStatus status = path_search_.advance(std::max(1, budget));
+    s.action_search_pops = path_search_.pops();
+    if (status == PathSearchStatus::running) return;
+    s.action_search_pops = 0;
+    if (status == PathSearchStatus::found && path_search_.path().size() <= static_cast<size_t>(kGraphActionPath)) {
+        const std::span<const std::int32_t> path = path_search_.path();
+        for (size_t i = 0; i < path.size(); ++i) s.action_path[i] = path[i];
+        s.action_path_length = static_cast<std::int32_t>(path.size());
+        s.action_path_next = 0;
+        s.mode = GraphMotionMode::to_action;
+    } else {  // unreachable, or a path longer than the state holds: the press is dropped
+        s.mode = GraphMotionMode::locomotion;
+        s.action_label = -1;
+    }
+    // A finished query is never resumed: a state still searching re-derives its own.
+    path_search_label_ = -1;
 }
 
 void GraphController::step(GraphControllerState& s, const GraphControllerInput& in, std::span<quat> rotations,
@@ -315,20 +406,14 @@ void GraphController::step(GraphControllerState& s, const GraphControllerInput& 
         for (int b = 0; b < kGraphActionButtons; ++b) {
             const int label = config_.button_label[static_cast<size_t>(b)];
             if (!((pressed >> b) & 1u) || label < 0) continue;
-            path_search_.clear_goals();
-            path_search_.add_label_goal(label);
-            const int from = graph_.edges[static_cast<size_t>(s.edge)].to;
-            if (path_search_.run(from) && path_search_.path().size() <= static_cast<size_t>(kGraphActionPath)) {
-                const std::span<const std::int32_t> path = path_search_.path();
-                for (size_t i = 0; i < path.size(); ++i) s.action_path[i] = path[i];
-                s.action_path_length = static_cast<std::int32_t>(path.size());
-                s.action_path_next = 0;
-                s.action_label = label;
-                s.mode = GraphMotionMode::to_action;
-            }
+            s.mode = GraphMotionMode::find_action;
+            s.action_label = label;
+            s.action_search_pops = 0;
+            s.action_path_length = 0, s.action_path_next = 0;
             break;
         }
     }
+    if (s.mode == GraphMotionMode::find_action) advance_action_search(s, config_.max_nodes_per_tick);
 
     // The velocity the stick asks for, on the ground plane as the gait reads it.
     const float vx = static_cast<float>(in.stick_x * config_.max_speed);
@@ -336,7 +421,7 @@ void GraphController::step(GraphControllerState& s, const GraphControllerInput& 
     const float dvx = vx - s.desired_vx, dvz = vz - s.desired_vz;
     const double change = config_.max_speed * 0.25;
     s.desired_vx = vx, s.desired_vz = vz;
-    if (s.mode == GraphMotionMode::locomotion) {
+    if (steering(s)) {
         // A search restarts when the stick moved on; a finished one keeps its answer.
         if ((s.search_depth < 0 && s.best_edge < 0) || dvx * dvx + dvz * dvz > change * change) search_start(s);
         search_run(s, config_.max_nodes_per_tick);
@@ -355,7 +440,9 @@ void GraphController::step(GraphControllerState& s, const GraphControllerInput& 
         start_edge(s, next);
         s.search_depth = -1;
         s.best_edge = -1;
-        if (s.mode == GraphMotionMode::locomotion) search_start(s);
+        if (steering(s)) search_start(s);
+        // An unfinished path query starts again from the end of the new edge.
+        if (s.mode == GraphMotionMode::find_action) s.action_search_pops = 0;
     }
     pose(s, rotations, translations);
     const GraphEdge& e = graph_.edges[static_cast<size_t>(s.edge)];

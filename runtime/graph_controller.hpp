@@ -8,8 +8,25 @@
 //     scoring where the root ends up after `horizon_s` against where the stick's
 //     desired velocity would put it; its work per tick is capped and a search is
 //     spread over the ticks of the edge being played, so no tick spikes;
-//   - actions: a requested label is reached by the cheapest path
-//     (GraphPathSearch), its clip is played to its end, then locomotion resumes;
+//   - actions: a requested label is reached by the cheapest path, its clip is
+//     played to its end, then locomotion resumes. The path query (Dijkstra,
+//     GraphPathSearch) runs in slices of at most `max_nodes_per_tick` heap pops
+//     per tick from the end of the edge being played, while locomotion goes on;
+//     if that edge ends first, the query restarts from the end of the next one.
+//     Its answer is the one-shot query's, bit for bit.
+//     Where the query's scratch lives: its labels and heap are large (nodes +
+//     edges), so they stay in the controller, and the state records only what
+//     they are a pure function of: the start node (the end of `edge`), the label
+//     (`action_label`) and the number of heap pops done (`action_search_pops`).
+//     Before slicing on, step() checks that its scratch is that function of this
+//     state and otherwise re-derives it (restart, pop `action_search_pops` times,
+//     a one-off catch-up): a state copied mid-query (snapshot, retune, a second
+//     state stepped by the same controller, another controller) continues
+//     exactly as the original would.
+//   - facing: steering compares the stick with each frame's facing: the root's
+//     +Z axis turned by `facing_offset()`, which estimate_graph_facing() derives
+//     once at construction from the direction of travel of the walking clips
+//     (0 for the puppet and for CMU data, whose roots face +Z);
 //   - attract mode: after `attract_after_s` without input, a random walk whose
 //     edge probabilities fall with the transition distance (PRNG in the state).
 // The state is plain fixed-size data (no pointers), so it can live in
@@ -46,7 +63,18 @@ struct GraphControllerConfig {
     GraphControllerConfig() { button_label.fill(-1); }
 };
 
-enum class GraphMotionMode : std::int32_t { locomotion = 0, to_action = 1, action = 2, attract = 3 };
+// find_action: locomotion goes on while the path to action_label is searched.
+enum class GraphMotionMode : std::int32_t { locomotion = 0, to_action = 1, action = 2, attract = 3, find_action = 4 };
+
+// The facing of a graph's clips relative to the root's +Z axis (radians, a yaw
+// about +Y): the mean over walk-labelled clips (all clips when no label is
+// `walk`) of the angle from the root's +Z to the direction of travel, at frames
+// moving faster than 40 % of their clip's top speed, weighted by speed. Within
+// 15° of a multiple of 90° it snaps to it (skeletons face an axis; the residue
+// is gait sway and curved paths), and it is 0 when the clips do not move or
+// their directions disagree (mean resultant below 0.5). `samples` returns the
+// frames used, `agreement` the mean resultant length.
+double estimate_graph_facing(const MotionGraph& graph, int* samples = nullptr, double* agreement = nullptr);
 
 // One level of the look-ahead search: the state after the edges chosen so far.
 struct GraphSearchLevel {
@@ -70,6 +98,8 @@ struct GraphControllerState {
     // Path to the action clip, edges in order, and how far along it is.
     std::array<std::int32_t, kGraphActionPath> action_path{};
     std::int32_t action_path_length = 0, action_path_next = 0;
+    // find_action: heap pops the path query from the end of `edge` has done.
+    std::int64_t action_search_pops = 0;
     // The look-ahead search for the decision at the end of the current edge.
     std::array<GraphSearchLevel, kGraphSearchDepth + 1> search{};
     std::int32_t search_depth = -1;  // −1: no search running
@@ -94,7 +124,9 @@ public:
 
     const MotionGraph& graph() const { return graph_; }
     const GraphControllerConfig& config() const { return config_; }
-    void set_config(const GraphControllerConfig& config) { config_ = config; }
+    void set_config(const GraphControllerConfig& config);
+    // Yaw from the root's +Z to the clips' forward (estimate_graph_facing).
+    double facing_offset() const { return facing_offset_; }
 
     // The state at the first clip edge of the graph, at the origin.
     GraphControllerState initial_state() const;
@@ -120,13 +152,19 @@ private:
     void search_run(GraphControllerState& s, int budget) const;
     int random_edge(GraphControllerState& s) const;
     int clip_edge_of(int node) const;
+    void advance_action_search(GraphControllerState& s, int budget);
+    bool steering(const GraphControllerState& s) const {
+        return s.mode == GraphMotionMode::locomotion || s.mode == GraphMotionMode::find_action;
+    }
 
     const MotionGraph& graph_;
     GraphControllerConfig config_;
-    GraphPathSearch path_search_;
+    GraphPathSearch path_search_;  // the action query's scratch (see the top of this file)
+    std::int32_t path_search_label_ = -1;  // label path_search_ is searching for, −1: none yet
     std::vector<quat> rot_a_, rot_b_;
     std::vector<vec3> tra_a_, tra_b_;
-    std::vector<float> frame_yaw_;  // per database frame: root facing in clip coordinates
+    std::vector<float> frame_yaw_;  // per database frame: facing in clip coordinates
+    double facing_offset_ = 0.0;
     // Per node: seconds (path cost) to the nearest node where the root moves at
     // walking speed, and to the nearest where it stands still. The look-ahead sees
     // only `horizon_s`; these tell it which way the rest of the graph lies (from an

@@ -26,6 +26,7 @@ GraphPathSearch::GraphPathSearch(const MotionGraph& g, double transition_weight)
     const size_t n = g.nodes.size();
     distance_.resize(n);
     via_edge_.resize(n);
+    stamp_.assign(n, 0);
     goal_extra_.assign(n, -1.0);
     goal_after_.assign(n, 0);
     heap_.reserve(g.edges.size() + n + 1);
@@ -33,14 +34,16 @@ GraphPathSearch::GraphPathSearch(const MotionGraph& g, double transition_weight)
 }
 
 void GraphPathSearch::clear_goals() {
+    goal_labels_ = 0;
+    if (!frame_goals_) return;
     std::fill(goal_extra_.begin(), goal_extra_.end(), -1.0);
     std::fill(goal_after_.begin(), goal_after_.end(), 0);
+    frame_goals_ = false;
 }
 
 void GraphPathSearch::add_label_goal(int label) {
     if (label < 0 || label >= kMaxGraphLabels) return;
-    for (size_t n = 0; n < graph_.nodes.size(); ++n)
-        if (graph_.clips[static_cast<size_t>(graph_.nodes[n].clip)].label_mask & (1u << label)) goal_extra_[n] = 0.0;
+    goal_labels_ |= 1u << label;
 }
 
 bool GraphPathSearch::add_frame_goal(int clip, int frame) {
@@ -48,36 +51,82 @@ bool GraphPathSearch::add_frame_goal(int clip, int frame) {
     if (at.node < 0) return false;
     goal_extra_[static_cast<size_t>(at.node)] = at.frames_after / graph_.frame_rate;
     goal_after_[static_cast<size_t>(at.node)] = at.frames_after;
+    frame_goals_ = true;
     return true;
 }
 
+double GraphPathSearch::distance(size_t node) const {
+    return stamp_[node] == generation_ ? distance_[node] : std::numeric_limits<double>::infinity();
+}
+
+// A label goal costs nothing more on arrival; a frame goal adds the frames still
+// to play after its node. −1: not a goal.
+double GraphPathSearch::goal_extra(size_t node) const {
+    const double frame_extra = goal_extra_[node];
+    const bool labelled = (graph_.clips[static_cast<size_t>(graph_.nodes[node].clip)].label_mask & goal_labels_) != 0;
+    return labelled ? 0.0 : frame_extra;
+}
+
 bool GraphPathSearch::run(int start) {
-    const double inf = std::numeric_limits<double>::infinity();
-    std::fill(distance_.begin(), distance_.end(), inf);
-    std::fill(via_edge_.begin(), via_edge_.end(), -1);
+    begin(start);
+    return advance(std::numeric_limits<std::int64_t>::max()) == PathSearchStatus::found;
+}
+
+void GraphPathSearch::begin(int start) {
+    if (++generation_ == 0) {  // wrapped: old stamps could alias the new generation
+        std::fill(stamp_.begin(), stamp_.end(), 0u);
+        generation_ = 1;
+    }
     heap_.clear();
     path_length_ = 0;
     goal_node_ = -1;
+    goal_frames_after_ = 0;
+    cost_ = 0.0;
+    best_ = std::numeric_limits<double>::infinity();
     settled_ = 0;
-    if (start < 0 || static_cast<size_t>(start) >= graph_.nodes.size()) return false;
+    pops_ = 0;
+    start_ = start;
+    if (start < 0 || static_cast<size_t>(start) >= graph_.nodes.size()) {
+        status_ = PathSearchStatus::unreachable;
+        return;
+    }
+    const size_t s = static_cast<size_t>(start);
+    stamp_[s] = generation_;
+    distance_[s] = 0.0;
+    via_edge_[s] = -1;
+    heap_.push_back({0.0, start});
+    status_ = PathSearchStatus::running;
+}
+
+PathSearchStatus GraphPathSearch::advance(std::int64_t max_pops) {
     // Min-heap on (cost, node): ties resolve by node index, so results are deterministic.
     const auto later = [](const std::pair<double, std::int32_t>& a, const std::pair<double, std::int32_t>& b) {
         return a.first != b.first ? a.first > b.first : a.second > b.second;
     };
-    distance_[static_cast<size_t>(start)] = 0.0;
-    heap_.push_back({0.0, start});
-    double best = inf;
-    while (!heap_.empty()) {
+    const std::int64_t limit =
+        max_pops >= std::numeric_limits<std::int64_t>::max() - pops_ ? std::numeric_limits<std::int64_t>::max() : pops_ + max_pops;
+    // The end is checked before the budget, so where the query stands after k pops
+    // does not depend on how the pops were sliced.
+    while (status_ == PathSearchStatus::running) {
+        if (heap_.empty()) {
+            finish();
+            break;
+        }
+        if (pops_ >= limit) break;
         std::pop_heap(heap_.begin(), heap_.end(), later);
         const auto [d, v] = heap_.back();
         heap_.pop_back();
+        ++pops_;
         // Every later node costs at least d, so once d reaches the best goal we are done.
-        if (d >= best) break;
-        if (d > distance_[static_cast<size_t>(v)]) continue;
+        if (d >= best_) {
+            finish();
+            break;
+        }
+        if (d > distance(static_cast<size_t>(v))) continue;
         ++settled_;
-        const double extra = goal_extra_[static_cast<size_t>(v)];
-        if (extra >= 0.0 && d + extra < best) {
-            best = d + extra;
+        const double extra = goal_extra(static_cast<size_t>(v));
+        if (extra >= 0.0 && d + extra < best_) {
+            best_ = d + extra;
             goal_node_ = v;
         }
         for (const GraphEdge& e : graph_.out_edges(v)) {
@@ -85,7 +134,8 @@ bool GraphPathSearch::run(int start) {
             const size_t w = static_cast<size_t>(e.to);
             // Lazy deletion pushes at most one entry per edge relaxation: the
             // capacity reserved (edges + nodes + 1) is never exceeded.
-            if (nd < distance_[w] && heap_.size() < heap_.capacity()) {
+            if (nd < distance(w) && heap_.size() < heap_.capacity()) {
+                stamp_[w] = generation_;
                 distance_[w] = nd;
                 via_edge_[w] = graph_.edge_index(e);
                 heap_.push_back({nd, static_cast<std::int32_t>(w)});
@@ -93,19 +143,27 @@ bool GraphPathSearch::run(int start) {
             }
         }
     }
-    if (goal_node_ < 0) return false;
-    cost_ = best;
+    return status_;
+}
+
+void GraphPathSearch::finish() {
+    heap_.clear();
+    if (goal_node_ < 0) {
+        status_ = PathSearchStatus::unreachable;
+        return;
+    }
+    status_ = PathSearchStatus::found;
+    cost_ = best_;
     goal_frames_after_ = goal_after_[static_cast<size_t>(goal_node_)];
     std::int32_t v = goal_node_;
     size_t count = 0;
-    while (v != start && count < path_.size()) {
+    while (v != start_ && count < path_.size()) {
         const std::int32_t e = via_edge_[static_cast<size_t>(v)];
         path_[count++] = e;
         v = graph_.edges[static_cast<size_t>(e)].from;
     }
     std::reverse(path_.begin(), path_.begin() + static_cast<std::ptrdiff_t>(count));
     path_length_ = count;
-    return true;
 }
 
 float transition_weight(int p, int k) {

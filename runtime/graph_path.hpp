@@ -3,7 +3,9 @@
 // distance + seconds of motion), and the poses along a path: clip frames placed in
 // the world, transitions blended with Kovar's ease weights. The search object owns
 // all its memory, sized once from the graph, so a query inside the tick never
-// allocates.
+// allocates. A query can run in one go (run) or in slices of a bounded number of
+// heap pops (begin + advance): the slices reach exactly the one-shot answer, and
+// the answer after k pops depends only on (graph, weight, goals, start, k).
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -24,10 +26,17 @@ GraphLocation locate_frame(const MotionGraph& graph, int clip, int frame);
 // Seconds of motion plus transition_weight × distance, per edge.
 double edge_cost(const MotionGraph& graph, const GraphEdge& edge, double transition_weight);
 
+enum class PathSearchStatus : std::int32_t { running = 0, found = 1, unreachable = 2 };
+
 class GraphPathSearch {
 public:
     explicit GraphPathSearch(const MotionGraph& graph, double transition_weight = 1.0);
 
+    void set_transition_weight(double weight) { transition_weight_ = weight; }
+    double transition_weight() const { return transition_weight_; }
+
+    // Goals are read while the search runs: change them only between queries.
+    // clear_goals and add_label_goal are O(1) unless frame goals were added.
     void clear_goals();
     // Every node of a clip carrying the label (bit index into graph.labels).
     void add_label_goal(int label);
@@ -36,6 +45,17 @@ public:
 
     // Dijkstra from `start`; false when no goal is reachable. Never allocates.
     bool run(int start);
+
+    // The same search in slices: begin() is O(1) (labels are stamped with a
+    // query generation, not cleared), advance() pops at most `max_pops` heap
+    // entries (each relaxes the popped node's out-edges) and returns where the
+    // query stands. Never allocates.
+    void begin(int start);
+    PathSearchStatus advance(std::int64_t max_pops);
+    PathSearchStatus status() const { return status_; }
+    std::int32_t start() const { return start_; }
+    // Heap pops so far in this query: the measure of its progress.
+    std::int64_t pops() const { return pops_; }
 
     double cost() const { return cost_; }
     int goal_node() const { return goal_node_; }
@@ -46,19 +66,31 @@ public:
     std::int64_t settled_nodes() const { return settled_; }
 
 private:
+    double distance(size_t node) const;
+    double goal_extra(size_t node) const;
+    void finish();
+
     const MotionGraph& graph_;
     double transition_weight_;
-    std::vector<double> distance_;
+    std::vector<double> distance_;        // valid where stamp_ == generation_
     std::vector<std::int32_t> via_edge_;
-    std::vector<double> goal_extra_;      // < 0: not a goal
+    std::vector<std::uint32_t> stamp_;
+    std::uint32_t generation_ = 0;
+    std::uint32_t goal_labels_ = 0;       // label goals: bit mask over graph.labels
+    bool frame_goals_ = false;            // goal_extra_ holds a frame goal
+    std::vector<double> goal_extra_;      // < 0: not a frame goal
     std::vector<std::int32_t> goal_after_;
     std::vector<std::pair<double, std::int32_t>> heap_;
     std::vector<std::int32_t> path_;
     size_t path_length_ = 0;
     double cost_ = 0.0;
+    double best_ = 0.0;                   // cheapest goal cost found so far in this query
+    std::int32_t start_ = -1;
     std::int32_t goal_node_ = -1;
     std::int32_t goal_frames_after_ = 0;
     std::int64_t settled_ = 0;
+    std::int64_t pops_ = 0;
+    PathSearchStatus status_ = PathSearchStatus::unreachable;
 };
 
 // Kovar's ease-in/ease-out weight of the source clip at blend frame p of k:

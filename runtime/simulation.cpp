@@ -268,6 +268,12 @@ float heading_of(quat root_rotation) {
 float smoothstep(float u) { return u * u * (3.0f - 2.0f * u); }
 }  // namespace
 
+// The facing of a graph pose: the root's +Z turned by the graph's facing offset
+// (the clips' forward as the controller measured it from their travel).
+float Simulation::graph_heading(quat root_rotation) const {
+    return static_cast<float>(det::wrap_angle(heading_of(root_rotation) + graph_controller_->facing_offset()));
+}
+
 // Where a source puts the puppet's root (ground point under the pelvis) and which way it faces.
 void Simulation::output(const Pose& pose, std::int32_t source, float dt) {
     PuppetState& s = state_;
@@ -289,7 +295,7 @@ void Simulation::output(const Pose& pose, std::int32_t source, float dt) {
     const vec2 before(s.root_position.x, s.root_position.z);
     s.root_position = vec3(p.x, source == kSourceGraphFeet ? s.feet.body_offset : 0.0f, p.z);
     if (dt > 0.0f) s.velocity = (vec2(p.x, p.z) - before) / dt;
-    s.heading = heading_of(pose.model_rotations[root]);
+    s.heading = graph_heading(pose.model_rotations[root]);
 }
 
 // The cross-fade of a change of source: local rotations slerped, translations
@@ -307,7 +313,7 @@ void Simulation::output_blend(const Pose& from, const Pose& to, float weight, fl
         const size_t root = static_cast<size_t>(foot_rig_.root);
         position = vec3(pose.model_positions[root].x, source == kSourceGraphFeet ? s.feet.body_offset : 0.0f,
                         pose.model_positions[root].z);
-        heading = heading_of(pose.model_rotations[root]);
+        heading = graph_heading(pose.model_rotations[root]);
     };
     vec3 p_from, p_to;
     float h_from = 0.0f, h_to = 0.0f;
@@ -351,7 +357,7 @@ void Simulation::begin_source_change(std::int32_t source) {
                                 std::span<vec3>(blend_pose_.local_translations.data(), n));
         const size_t root = static_cast<size_t>(foot_rig_.root);
         const vec3 r = blend_pose_.local_translations[root];
-        const double turn = det::wrap_angle(static_cast<double>(s.heading) - heading_of(blend_pose_.local_rotations[root]));
+        const double turn = det::wrap_angle(static_cast<double>(s.heading) - graph_heading(blend_pose_.local_rotations[root]));
         double sn = 0.0, cs = 0.0;
         det::sin_cos(turn, sn, cs);
         const PlanarTransform anchor{turn, s.root_position.x / metres_per_unit_ - (cs * r.x + sn * r.z),

@@ -122,6 +122,7 @@ private:
     void step_graph(const TickInput& input, float dt, Pose& out);
     void place_feet(const Pose& clip, float dt, Pose& out);
     void begin_source_change(std::int32_t source);
+    float graph_heading(quat root_rotation) const;
     void output(const Pose& pose, std::int32_t source, float dt);
     void output_blend(const Pose& from, const Pose& to, float weight, float dt);
 

@@ -4,12 +4,17 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <limits>
+#include <memory>
 
 #include "app/default_graph.hpp"
+#include "app/graph_files.hpp"
 #include "motion_graph/clip_database.hpp"
 #include "runtime/graph_path.hpp"
 #include "runtime/puppet.hpp"
 #include "runtime/simulation.hpp"
+#include "runtime/tick_input.hpp"
+#include "tests/graph_path_check.hpp"
 
 using namespace marionette;
 
@@ -126,4 +131,117 @@ TEST_CASE("default graph: paths from idle reach every label with continuous pose
         const Clip motion = synthesize_path(g, idle, g.nodes[static_cast<size_t>(start)].frame, path, 5);
         CHECK(max_joint_step(motion) <= 1.5 * source_worst);
     }
+}
+
+TEST_CASE("default graph: sliced action queries reach the one-shot answer from every node", "[default_graph][path]") {
+    const MotionGraph& g = default_build().output.graph;
+    const test::SlicedQueryStats stats = test::check_sliced_queries(g, {1, 5, 64});
+    CHECK(stats.found == stats.queries);  // strongly connected, every label kept
+    // With the default budget a query is done within the shortest edge it can start
+    // on, so a press waits at most the rest of the current edge and one more.
+    int shortest_edge_ticks = std::numeric_limits<int>::max();
+    const SimConfig config;
+    for (const GraphEdge& e : g.edges)
+        shortest_edge_ticks = std::min(shortest_edge_ticks, static_cast<int>(e.frames * config.tick_rate_hz / g.frame_rate));
+    INFO("most pops " << stats.max_pops << ", shortest edge " << shortest_edge_ticks << " ticks, budget "
+                      << config.graph_max_nodes_per_tick);
+    CHECK(stats.max_pops <= static_cast<std::int64_t>(shortest_edge_ticks) * config.graph_max_nodes_per_tick);
+    CHECK(stats.max_path_edges <= kGraphActionPath);
+}
+
+namespace {
+
+struct ActionRun {
+    std::vector<std::uint64_t> hashes;
+    int press_tick = 0, reached_tick = -1, left_tick = -1, back_to_locomotion_tick = -1;
+    int ticks_on_label = 0;
+    std::int64_t actions_played = 0;
+    double max_joint_move_m = 0.0;
+    std::string clip_after;
+};
+
+// Drives a simulation from the default graph (`--graph default`'s attach) with
+// the stick at `stick_y` (forward), pressing button `button` for 100 ms at 3 s,
+// for 12 s; records when the puppet first plays a frame of a clip carrying
+// `label`, when it leaves it, when the controller is back in locomotion, and the
+// largest world-space joint move in one tick.
+ActionRun run_action(const std::shared_ptr<const MotionGraph>& graph, int button, const std::string& label, float stick_y) {
+    const SimConfig config;
+    Simulation sim(config);
+    attach_motion_graph(sim, graph);
+    const int label_index = graph->label_index(label);
+    REQUIRE(label_index >= 0);
+    ActionRun out;
+    out.press_tick = 3 * config.tick_rate_hz;
+    const int ticks = 12 * config.tick_rate_hz;
+    const size_t joints = static_cast<size_t>(graph->joint_count());
+    std::vector<vec3> previous;
+    for (int tick = 0; tick < ticks; ++tick) {
+        TickInput in{};
+        in.left_y = static_cast<std::int16_t>(stick_y * kStickScale);
+        if (tick >= out.press_tick && tick < out.press_tick + config.tick_rate_hz / 10)
+            in.buttons = static_cast<std::uint16_t>(1u << button);
+        sim.step(in);
+        const PuppetState& s = sim.state();
+        out.hashes.push_back(hash_state(s));
+        if (!previous.empty())
+            for (size_t j = 0; j < joints; ++j)
+                out.max_joint_move_m = std::max(out.max_joint_move_m, static_cast<double>(glm::length(s.model_positions[j] - previous[j])));
+        previous.assign(s.model_positions.begin(), s.model_positions.begin() + static_cast<std::ptrdiff_t>(joints));
+        // The frame being shown: a clip edge's clip, or a transition's source clip
+        // (its target clip once the blend is past half way).
+        const GraphEdge& e = graph->edges[static_cast<size_t>(s.graph.edge)];
+        const bool second_half = e.kind == GraphEdgeKind::transition && s.graph.edge_position >= 0.5f * static_cast<float>(e.frames);
+        const int clip = graph->nodes[static_cast<size_t>(second_half ? e.to : e.from)].clip;
+        const bool on_label = (graph->clips[static_cast<size_t>(clip)].label_mask >> label_index) & 1u;
+        if (tick < out.press_tick) continue;
+        if (on_label) {
+            ++out.ticks_on_label;
+            if (out.reached_tick < 0) out.reached_tick = tick;
+        } else if (out.reached_tick >= 0 && out.left_tick < 0) {
+            out.left_tick = tick;
+            out.clip_after = graph->clips[static_cast<size_t>(clip)].name;
+        }
+        if (out.reached_tick >= 0 && out.back_to_locomotion_tick < 0 && s.graph.mode == GraphMotionMode::locomotion)
+            out.back_to_locomotion_tick = tick;
+    }
+    out.actions_played = sim.state().graph.actions_played;
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("default graph: every face button plays its action while walking and standing, then locomotion resumes",
+          "[default_graph][controller]") {
+    const auto graph = std::make_shared<const MotionGraph>(default_build().output.graph);
+    const SimConfig config;
+    const int hz = config.tick_rate_hz;
+    const char* const labels[4] = {"jump", "wave", "bow", "look_around"};  // south, east, west, north
+    const std::string locomotion[] = {"walk", "run", "turn", "idle", "stop"};
+    for (int button = 0; button < 4; ++button)
+        for (const float stick_y : {0.5f, 0.0f}) {
+            const std::string label = labels[button];
+            INFO(kButtonNames[static_cast<size_t>(button)] << " → " << label << (stick_y > 0.0f ? " while walking" : " standing"));
+            const ActionRun run = run_action(graph, button, label, stick_y);
+            INFO("reached after " << (run.reached_tick - run.press_tick) << " ticks, on it " << run.ticks_on_label
+                                  << " ticks, then " << run.clip_after << "; largest joint move " << run.max_joint_move_m << " m");
+            REQUIRE(run.reached_tick >= 0);
+            // Within two seconds standing; walking, the default graph has to stop first
+            // (its action clips start and end standing): within four.
+            CHECK(run.reached_tick - run.press_tick <= (stick_y > 0.0f ? 4 : 2) * hz);
+            CHECK(run.ticks_on_label >= hz / 2);                 // and played, not just touched
+            CHECK(run.left_tick > run.reached_tick);             // then left again
+            CHECK(run.back_to_locomotion_tick > run.reached_tick);
+            CHECK(run.actions_played == 1);
+            // What follows is locomotion: a clip with a locomotion label.
+            const int after = graph->clip_index(run.clip_after);
+            REQUIRE(after >= 0);
+            std::uint32_t mask = 0;
+            for (const std::string& l : locomotion) mask |= 1u << graph->label_index(l);
+            CHECK((graph->clips[static_cast<size_t>(after)].label_mask & mask) != 0u);
+            // No joint jumps: 2 cm in a 240 Hz tick is 4.8 m/s, faster than the jump's arm swing.
+            CHECK(run.max_joint_move_m < 0.02);
+            // Deterministic: a second run gives the same hash every tick.
+            if (button == 0) CHECK(run_action(graph, button, label, stick_y).hashes == run.hashes);
+        }
 }

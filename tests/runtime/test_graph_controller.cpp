@@ -12,6 +12,7 @@
 #include "runtime/tick_input.hpp"
 #include "tests/alloc_counter.hpp"
 #include "tests/graph_fixture.hpp"
+#include "tests/graph_path_check.hpp"
 
 using namespace marionette;
 
@@ -229,4 +230,80 @@ TEST_CASE("a simulation driven by a motion graph walks, repeats its hashes and n
     run(a);
     run(b);
     CHECK(a == b);
+}
+
+TEST_CASE("sliced path queries on the test graph reach the one-shot answer bit for bit", "[graph][controller][path]") {
+    const MotionGraph g = test::make_locomotion_graph();
+    const test::SlicedQueryStats stats = test::check_sliced_queries(g, {1, 2, 3, 7, 64});
+    CHECK(stats.queries == static_cast<std::int64_t>(g.nodes.size() * g.labels.size()));
+    CHECK(stats.found == stats.queries);  // the test graph is strongly connected
+    CHECK(stats.max_pops > 3);            // budgets 1, 2 and 3 really slice
+}
+
+namespace {
+// The fields that decide what the controller does next (the rest are counters).
+void check_same_state(const GraphControllerState& a, const GraphControllerState& b) {
+    CHECK(a.edge == b.edge);
+    CHECK(a.edge_position == b.edge_position);
+    CHECK(a.world_angle == b.world_angle);
+    CHECK(a.world_dx == b.world_dx);
+    CHECK(a.world_dz == b.world_dz);
+    CHECK(a.mode == b.mode);
+    CHECK(a.action_label == b.action_label);
+    CHECK(a.action_search_pops == b.action_search_pops);
+    CHECK(a.action_path_length == b.action_path_length);
+    CHECK(a.action_path_next == b.action_path_next);
+    CHECK(a.action_path == b.action_path);
+    CHECK(a.search_depth == b.search_depth);
+    CHECK(a.best_edge == b.best_edge);
+    CHECK(a.nodes_expanded == b.nodes_expanded);
+    CHECK(a.actions_played == b.actions_played);
+    CHECK(a.rng == b.rng);
+}
+}  // namespace
+
+TEST_CASE("an action query spread over ticks continues identically from a copied state", "[graph][controller]") {
+    const MotionGraph graph = test::make_locomotion_graph();
+    GraphControllerConfig config;
+    config.max_speed = 1.2;
+    config.max_nodes_per_tick = 2;  // the wave query takes several ticks
+    config.button_label[1] = graph.label_index("wave");
+    std::vector<quat> r(2);
+    std::vector<vec3> t(2);
+    const auto input = [](int tick) {
+        GraphControllerInput in;
+        in.dt = kDt;
+        in.stick_x = static_cast<float>(det::sin(tick * 0.02));
+        in.stick_y = -0.8f;
+        if (tick == 50 || tick == 250) in.buttons = 1u << 1;
+        return in;
+    };
+    GraphController original(graph, config), fresh(graph, config), shared(graph, config);
+    GraphControllerState s = original.initial_state();
+    int searching_ticks = 0, copies = 0;
+    for (int tick = 0; tick < 480; ++tick) {
+        if (s.mode == GraphMotionMode::find_action && s.action_search_pops > 0 && copies < 4) {
+            // A copy taken mid-query, stepped by a fresh controller, and by one whose
+            // scratch another state has just used, follows the original tick for tick.
+            ++copies;
+            GraphControllerState by_fresh = s, by_shared = s, other = shared.initial_state(), a = s;
+            GraphController follow(graph, config);
+            for (int k = 0; k < 60; ++k) {
+                GraphControllerInput in = input(tick + k);
+                in.buttons = static_cast<std::uint16_t>(in.buttons | (1u << 1));  // keeps `other` querying too
+                GraphControllerInput plain = input(tick + k);
+                follow.step(a, plain, r, t);
+                fresh.step(by_fresh, plain, r, t);
+                shared.step(other, k % 7 == 0 ? in : plain, r, t);
+                shared.step(by_shared, plain, r, t);
+            }
+            check_same_state(a, by_fresh);
+            check_same_state(a, by_shared);
+        }
+        if (s.mode == GraphMotionMode::find_action) ++searching_ticks;
+        original.step(s, input(tick), r, t);
+    }
+    CHECK(copies == 4);
+    CHECK(searching_ticks >= 4);  // both queries took more than one tick
+    CHECK(s.actions_played == 2);
 }
