@@ -2,13 +2,32 @@
 // Every tunable the simulation reads, as plain data. Loading, validation and the
 // documentation of each key live with the TOML schema (app/config.cpp,
 // docs/config.md); the defaults here are the ones config/marionette.toml states.
+#include <array>
 #include <cstdint>
 #include <string>
 
 #include "runtime/gait_prototype.hpp"
 #include "runtime/terrain.hpp"
+#include "runtime/tick_input.hpp"
 
 namespace marionette {
+
+// [motion_graph.buttons]: the graph label a button plays on press ("" for none),
+// and where the value came from, for the error when the graph lacks the label.
+struct GraphButtonBinding {
+    std::string label;
+    std::string file;           // configuration file that set it last
+    std::int32_t line = 0;      // 0: the built-in default
+};
+// Today's mapping: the face buttons play the default graph's actions.
+inline std::array<GraphButtonBinding, kButtonCount> default_graph_buttons() {
+    std::array<GraphButtonBinding, kButtonCount> b{};
+    b[static_cast<std::size_t>(Button::south)].label = "jump";
+    b[static_cast<std::size_t>(Button::east)].label = "wave";
+    b[static_cast<std::size_t>(Button::west)].label = "bow";
+    b[static_cast<std::size_t>(Button::north)].label = "look_around";
+    return b;
+}
 
 struct SimConfig {
     // [simulation]
@@ -93,6 +112,8 @@ struct SimConfig {
     float graph_attract_after_s = 30.0f;          // seconds without input before the attract-mode walk
     float graph_attract_temperature = 1.0f;       // attract walk: edge weight 1 / (1 + cost / temperature)
     std::int32_t graph_attract_seed = 1;          // attract-mode PRNG seed
+    // [motion_graph.buttons] button bit → label (runtime/tick_input.hpp kButtonNames order)
+    std::array<GraphButtonBinding, kButtonCount> graph_buttons = default_graph_buttons();
 };
 
 }  // namespace marionette
