@@ -21,7 +21,7 @@ ok = ok and d['steps'] > 0 and d['speed_windows'] == 1
 print('gait-eval --graph default fast_walk:', {k: d[k] for k in ['foot_skate_mm','penetration_mm','speed_error_pct','max_joint_speed_deg_s','steps','flight_phases']})
 sys.exit(0 if ok else 1)\""
 check "gait-eval --graph default --check exits 0 (only non-finite metrics fail with a graph)" \
-  "$bin" gait-eval --graph default --terrain flat --program builtin:slow_walk --check --json
+  bash -c "'$bin' gait-eval --graph default --terrain flat --program builtin:slow_walk --check --json >/dev/null"
 check "gait-eval without --graph says the gait drove it" bash -c "'$bin' gait-eval --terrain flat --program builtin:slow_walk --json | grep -q '\"motion_source\":\"gait\"'"
 
 # 2. [motion_graph.buttons]
@@ -69,6 +69,10 @@ PY
   printf '[motion_graph]\nwindow_frames = 8\n' >k8.toml
   check "changed [motion_graph] build parameters make it stale too" bash -c "
     '$bin' run --fast --duration 0.5 --graph small.mgraph --config k8.toml --input sim:builtin:slow_walk >run4.txt 2>&1 && grep -q 'rebuilt in' run4.txt && [[ \$('$bin' graph info small.mgraph --json | python3 -c 'import json,sys; print(json.load(sys.stdin)[\"window_frames\"])') == 8 ]]"
+  printf '[motion_graph]\nwindow_frames = 9\n' >k9.toml
+  check "record --graph rebuilds a stale graph too; replay of its log needs the rebuilt file and does not rebuild" bash -c "
+    '$bin' record --graph small.mgraph --config k9.toml --program '$src/config/programs/slow_walk.prog' -o k9.mlog >rec9.txt 2>&1 && grep -q 'rebuilt in' rec9.txt &&
+    '$bin' replay k9.mlog --graph small.mgraph --hash >rep9.txt 2>&1 && ! grep -q 'rebuilt' rep9.txt"
   cp small.mgraph kept.mgraph
   rm clips/16_41.amc
   check "missing sources: the graph is used as it is, with a warning" bash -c "
