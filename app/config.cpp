@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <variant>
 
@@ -111,6 +112,7 @@ std::string known_keys_of(std::string_view table) {
     std::string out;
     for (const KeySpec& k : kKeys)
         if (table == k.table) out += (out.empty() ? "" : ", ") + std::string(k.key);
+    if (table == "motion_graph") out += ", buttons (the [motion_graph.buttons] table)";
     return out;
 }
 
@@ -228,6 +230,40 @@ std::string read_file(const std::string& path) {
     return ss.str();
 }
 
+// ---- [motion_graph.buttons] (docs/config.md): button name → graph label -------
+constexpr std::size_t kMaxLabelLength = 64;
+
+void apply_buttons_table(SimConfig& config, const toml::node& node, const std::string& file) {
+    const toml::table* t = node.as_table();
+    std::string names;
+    for (const std::string_view n : kButtonNames) names += (names.empty() ? "" : ", ") + std::string(n);
+    if (!t) throw ConfigError(file, line_of(node), "motion_graph.buttons", "expected a table ([motion_graph.buttons]) of button = \"label\"");
+    for (const auto& [key, value] : *t) {
+        const std::string full = "motion_graph.buttons." + std::string(key.str());
+        const std::optional<Button> button = button_from_name(key.str());
+        if (!button) throw ConfigError(file, line_of(value), full, "unknown button (expected one of: " + names + ")");
+        const auto* label = value.as_string();
+        if (!label) throw ConfigError(file, line_of(value), full, "expected a label name in quotes, or \"\" for none");
+        const std::string& text = label->get();
+        if (text.size() > kMaxLabelLength)
+            throw ConfigError(file, line_of(value), full, "label longer than " + std::to_string(kMaxLabelLength) + " characters");
+        for (const char ch : text)
+            if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f)
+                throw ConfigError(file, line_of(value), full, "a label may not contain control characters");
+        GraphButtonBinding& b = config.graph_buttons[static_cast<std::size_t>(*button)];
+        b.label = text;
+        b.file = file;
+        b.line = line_of(value);
+    }
+}
+
+std::string serialize_buttons(const SimConfig& config) {
+    std::string out = "\n[motion_graph.buttons]\n";
+    for (std::size_t b = 0; b < kButtonNames.size(); ++b)
+        out += std::string(kButtonNames[b]) + " = " + toml_string(config.graph_buttons[b].label) + "\n";
+    return out;
+}
+
 }  // namespace
 
 std::vector<ConfigKeyInfo> config_schema() {
@@ -235,6 +271,8 @@ std::vector<ConfigKeyInfo> config_schema() {
     for (const KeySpec& k : kKeys)
         out.push_back({k.table, k.key, std::holds_alternative<IntField>(k.field) ? "integer" : "float", k.min, k.max, k.doc});
     out.push_back({"motion", "source", "string", 0, 0, "what poses the puppet: auto, gait, graph or graph_feet"});
+    for (const std::string_view b : kButtonNames)
+        out.push_back({"motion_graph.buttons", std::string(b), "string", 0.0, 0.0, "graph label played when the button is pressed, \"\" for none"});
     return out;
 }
 
@@ -263,6 +301,10 @@ SimConfig apply_config_text(const SimConfig& base, std::string_view text, const 
             const std::string full = table_name + "." + std::string(key.str());
             if (table_name == "motion" && key.str() == "source") {
                 apply_motion_source(config, node, file);
+                continue;
+            }
+            if (table_name == "motion_graph" && key.str() == "buttons") {
+                apply_buttons_table(config, node, file);
                 continue;
             }
             if (table_name == "gait" && (key.str() == "walk" || key.str() == "run")) {
@@ -355,6 +397,7 @@ std::string serialize_config(const SimConfig& config) {
     }
     out += serialize_prototypes(config.walk, "gait.walk");
     out += serialize_prototypes(config.run, "gait.run");
+    out += serialize_buttons(config);
     // The terrain, resolved and inline: the text alone determines the ground.
     out += "\n[terrain]\nname = " + toml_string(config.terrain_name) + "\n";
     out += serialize_terrain(config.terrain, "terrain.");

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "app/graph_files.hpp"
 #include "runtime/gait.hpp"
 #include "runtime/puppet.hpp"
 #include "runtime/simulation.hpp"
@@ -22,16 +23,74 @@ constexpr double kGroundedM = 0.002;
 constexpr double kSettleS = 1.5;
 constexpr double kMinWindowS = 1.0;
 
-struct FootPoints {
-    vec3 points[4];  // ankle, sole under the ankle, ball (toe joint), toe tip
+// The points of a foot checked against the ground. The gait's puppet has sole
+// geometry in the config (ankle height, toe length); a motion graph's skeleton
+// has only joints, so there the points are the foot joint, its first child (the
+// toe) and the end site beyond, as far as the skeleton has them.
+struct FootGeometry {
+    int ankle = -1;
+    int toe = -1;        // −1: none
+    int tip_parent = -1; // joint the tip's end site hangs from, −1: no tip
+    vec3 tip_offset{0.0f};  // metres, in tip_parent's frame
+    bool puppet_sole = false;  // the gait puppet: ankle/sole/ball/tip from the config
 };
 
-FootPoints foot_points(const PuppetState& s, int foot_joint, const SimConfig& c) {
-    const std::size_t f = static_cast<std::size_t>(foot_joint);
+struct FootPoints {
+    vec3 points[4];
+    int count = 0;
+    const char* const* names = nullptr;
+};
+
+const char* const kPuppetPointNames[4] = {"ankle", "sole under the ankle", "ball", "toe tip"};
+const char* const kGraphPointNames[3] = {"foot joint", "toe joint", "toe end site"};
+
+FootGeometry puppet_foot(int foot_joint) {
+    FootGeometry g;
+    g.ankle = foot_joint;
+    g.toe = foot_joint + 1;
+    g.puppet_sole = true;
+    return g;
+}
+
+FootGeometry graph_foot(const MotionGraph& graph, int foot_joint, double metres_per_unit) {
+    FootGeometry g;
+    g.ankle = foot_joint;
+    const Skeleton& sk = graph.skeleton;
+    for (int j = 0; j < sk.joint_count() && g.toe < 0; ++j)
+        if (sk.parents[static_cast<std::size_t>(j)] == foot_joint) g.toe = j;
+    const int last = g.toe >= 0 ? g.toe : foot_joint;
+    for (std::size_t e = 0; e < sk.end_site_parents.size(); ++e)
+        if (sk.end_site_parents[e] == last) {
+            g.tip_parent = last;
+            g.tip_offset = sk.end_site_offsets[e] * static_cast<float>(metres_per_unit);
+            break;
+        }
+    return g;
+}
+
+FootPoints foot_points(const PuppetState& s, const FootGeometry& g, const SimConfig& c) {
+    FootPoints fp;
+    const std::size_t f = static_cast<std::size_t>(g.ankle);
     const vec3 ankle = s.model_positions[f];
-    const vec3 toe = s.model_positions[f + 1];
-    return {{ankle, ankle + quat_rotate(s.model_rotations[f], vec3(0.0f, -c.ankle_height, 0.0f)), toe,
-             toe + quat_rotate(s.model_rotations[f + 1], vec3(0.0f, 0.0f, c.toe_length))}};
+    if (g.puppet_sole) {
+        const std::size_t t = static_cast<std::size_t>(g.toe);
+        const vec3 toe = s.model_positions[t];
+        fp.points[0] = ankle;
+        fp.points[1] = ankle + quat_rotate(s.model_rotations[f], vec3(0.0f, -c.ankle_height, 0.0f));
+        fp.points[2] = toe;
+        fp.points[3] = toe + quat_rotate(s.model_rotations[t], vec3(0.0f, 0.0f, c.toe_length));
+        fp.count = 4;
+        fp.names = kPuppetPointNames;
+        return fp;
+    }
+    fp.names = kGraphPointNames;
+    fp.points[fp.count++] = ankle;
+    if (g.toe >= 0) fp.points[fp.count++] = s.model_positions[static_cast<std::size_t>(g.toe)];
+    if (g.tip_parent >= 0) {
+        const std::size_t p = static_cast<std::size_t>(g.tip_parent);
+        fp.points[fp.count++] = s.model_positions[p] + quat_rotate(s.model_rotations[p], g.tip_offset);
+    }
+    return fp;
 }
 
 struct Hold {
@@ -72,6 +131,24 @@ std::vector<Hold> moving_holds(const StickProgram& program, const SimConfig& c) 
 
 }  // namespace
 
+bool foot_in_stance(const PuppetState& s, int foot) {
+    // graph_feet: a foot is planted while its pin holds it (not merely while the
+    // clip says contact: a pin let go for slipping is not a stance).
+    if (s.motion_source == kSourceGraphFeet) return s.feet.feet[static_cast<std::size_t>(foot)].contact == 1;
+    if (s.motion_source == kSourceGraph) return (s.graph.contacts & (foot == 0 ? kContactLeft : kContactRight)) != 0;
+    return s.gait.feet[static_cast<std::size_t>(foot)].swinging == 0;
+}
+
+std::string gait_metric_non_finite(const GaitMetrics& m) {
+    const std::pair<const char*, double> values[] = {{"foot_skate_mm", m.foot_skate_mm},
+                                                     {"penetration_mm", m.penetration_mm},
+                                                     {"speed_error_pct", m.speed_error_pct},
+                                                     {"max_joint_speed_deg_s", m.max_joint_speed_deg_s}};
+    for (const auto& [name, value] : values)
+        if (!std::isfinite(value)) return fmt::format("{} is not a finite number ({})", name, value);
+    return {};
+}
+
 std::string gait_limit_failures(const GaitMetrics& m) {
     std::string out;
     auto check = [&](const char* name, double value, double limit) {
@@ -84,7 +161,8 @@ std::string gait_limit_failures(const GaitMetrics& m) {
     return out;
 }
 
-GaitMetrics evaluate_gait(const SimConfig& config, const StickProgram& program, const std::string& feet_csv) {
+GaitMetrics evaluate_gait(const SimConfig& config, const StickProgram& program, const std::string& feet_csv,
+                          std::shared_ptr<const MotionGraph> graph) {
     std::string csv;
     if (!feet_csv.empty())
         csv = "tick,phase,speed,mode,pelvis_y,foot,swinging,progress,ankle_x,ankle_y,ankle_z,target_x,target_z,ankle_clear,sole_clear,ball_clear,tip_clear\n";
@@ -93,13 +171,32 @@ GaitMetrics evaluate_gait(const SimConfig& config, const StickProgram& program, 
     set_simulation_float_mode();
     Simulation sim(config);
     const Terrain& terrain = sim.terrain();
-    const int feet[2] = {kFootL, kFootR};
     GaitMetrics m;
+    FootGeometry feet[2] = {puppet_foot(kFootL), puppet_foot(kFootR)};
+    // Expected speed with a graph: the controller asks for stick deflection ×
+    // full_stick_speed leg lengths per second (no deadzone, curve or slope factor),
+    // and a leg is scaled to leg_metres (attach_motion_graph; a graph of the
+    // puppet's own skeleton is not scaled).
+    double graph_full_speed_m_s = static_cast<double>(config.graph_full_stick_speed) * config.graph_leg_metres;
+    if (graph) {
+        if (graph->left_foot < 0 || graph->right_foot < 0)
+            throw std::runtime_error("the motion graph names no left and right foot joints, so the foot metrics cannot be measured");
+        attach_motion_graph(sim, graph);
+        feet[0] = graph_foot(*graph, graph->left_foot, sim.metres_per_unit());
+        feet[1] = graph_foot(*graph, graph->right_foot, sim.metres_per_unit());
+        graph_full_speed_m_s = static_cast<double>(config.graph_full_stick_speed) *
+                               (graph->leg_length > 0.0f ? graph->leg_length : 1.0) * sim.metres_per_unit();
+        const std::int32_t source = sim.state().motion_source;
+        m.motion_source = source == kSourceGraphFeet ? "graph_feet" : source == kSourceGraph ? "graph" : "gait";
+        m.speed_expectation = "graph full_stick_speed x leg_metres x stick deflection";
+    }
+    const std::size_t pelvis_joint = graph ? 0 : static_cast<std::size_t>(kPelvis);
 
     PuppetState previous = sim.state();
     bool airborne[2] = {false, false};
     bool in_flight = false;
-    vec3 stance_anchor[2] = {sim.state().model_positions[kFootL], sim.state().model_positions[kFootR]};
+    vec3 stance_anchor[2] = {sim.state().model_positions[static_cast<std::size_t>(feet[0].ankle)],
+                             sim.state().model_positions[static_cast<std::size_t>(feet[1].ankle)]};
     bool was_stance[2] = {true, true};
     // Per hold: pelvis path length (sampled every quarter second) and expected speed.
     std::vector<double> path(holds.size(), 0.0), expected(holds.size(), 0.0);
@@ -112,24 +209,28 @@ GaitMetrics evaluate_gait(const SimConfig& config, const StickProgram& program, 
         for (int i = 0; i < 2; ++i) {
             const FootPoints fp = foot_points(s, feet[i], config);
             double lowest = 1e9;
-            static const char* const kPointNames[4] = {"ankle", "sole under the ankle", "ball", "toe tip"};
-            for (int p_index = 0; p_index < 4; ++p_index) {
+            const bool stance = foot_in_stance(s, i);
+            for (int p_index = 0; p_index < fp.count; ++p_index) {
                 const vec3& p = fp.points[p_index];
                 const double clearance = static_cast<double>(p.y) - query_ground(terrain, p.x, p.z).height;
                 if (-clearance * 1000.0 > m.penetration_mm) {
                     m.penetration_mm = -clearance * 1000.0;
                     m.deepest_tick = s.tick;
-                    m.deepest_point = fmt::format("{} {} ({})", i == 0 ? "left" : "right", kPointNames[p_index],
-                                                  s.gait.feet[static_cast<std::size_t>(i)].swinging ? "swing" : "stance");
+                    m.deepest_point = fmt::format("{} {} ({})", i == 0 ? "left" : "right", fp.names[p_index],
+                                                  stance ? "stance" : "swing");
                 }
                 lowest = std::min(lowest, clearance);
             }
             if (!feet_csv.empty()) {
                 const FootState& f = s.gait.feet[static_cast<std::size_t>(i)];
                 csv += fmt::format("{},{:.4f},{:.3f},{},{:.4f},{},{},{:.3f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f}", s.tick, s.gait.cycle_phase, s.gait.speed,
-                                   static_cast<int>(s.gait.mode), s.gait.pelvis.y, i, f.swinging, f.progress, fp.points[0].x,
+                                   static_cast<int>(s.gait.mode), s.gait.pelvis.y, i, stance ? 0 : 1, f.progress, fp.points[0].x,
                                    fp.points[0].y, fp.points[0].z, f.target.x, f.target.z);
-                for (const vec3& p : fp.points) csv += fmt::format(",{:.4f}", p.y - query_ground(terrain, p.x, p.z).height);
+                for (int p_index = 0; p_index < 4; ++p_index) {
+                    const vec3& p = fp.points[p_index];
+                    if (p_index < fp.count) csv += fmt::format(",{:.4f}", p.y - query_ground(terrain, p.x, p.z).height);
+                    else csv += ",";
+                }
                 csv += "\n";
             }
             if (!airborne[i] && lowest > kAirborneM) airborne[i] = true;
@@ -137,9 +238,8 @@ GaitMetrics evaluate_gait(const SimConfig& config, const StickProgram& program, 
                 airborne[i] = false;
                 ++m.steps;
             }
-            // Skate: while the gait holds the foot in stance, its joint must not move.
-            const bool stance = s.gait.feet[static_cast<std::size_t>(i)].swinging == 0;
-            const vec3 ankle = s.model_positions[static_cast<std::size_t>(feet[i])];
+            // Skate: while the foot is in stance (foot_in_stance), its joint must not move.
+            const vec3 ankle = s.model_positions[static_cast<std::size_t>(feet[i].ankle)];
             if (stance && !was_stance[i]) stance_anchor[i] = ankle;
             if (stance) {
                 const double dx = ankle.x - stance_anchor[i].x, dz = ankle.z - stance_anchor[i].z;
@@ -167,15 +267,22 @@ GaitMetrics evaluate_gait(const SimConfig& config, const StickProgram& program, 
                 m.fastest_joint_tick = s.tick;
             }
         }
-        // Speed over the holds: measured from the pelvis joint; expected from the
-        // stick through the documented response curve and slope factor.
-        const vec3 pelvis = s.model_positions[kPelvis];
+        // Speed over the holds: measured from the pelvis (with a graph, its root)
+        // joint; expected from the stick through the documented response curve and
+        // slope factor, or with a graph the controller's own target speed.
+        const vec3 pelvis = s.model_positions[pelvis_joint];
         for (std::size_t h = 0; h < holds.size(); ++h) {
             const Hold& hold = holds[h];
             if (k < hold.first_tick || k >= hold.end_tick) continue;
-            const float deflection = std::min(1.0f, std::sqrt(hold.stick_x * hold.stick_x + hold.stick_y * hold.stick_y));
-            expected[h] += config.max_speed * stick_speed_fraction(deflection, config) *
-                           slope_speed_multiplier(terrain, config, pelvis.x, pelvis.z, s.heading);
+            if (graph) {
+                const double sx = ticks[k].left_x / static_cast<double>(kStickScale);
+                const double sy = ticks[k].left_y / static_cast<double>(kStickScale);
+                expected[h] += graph_full_speed_m_s * std::sqrt(sx * sx + sy * sy);
+            } else {
+                const float deflection = std::min(1.0f, std::sqrt(hold.stick_x * hold.stick_x + hold.stick_y * hold.stick_y));
+                expected[h] += config.max_speed * stick_speed_fraction(deflection, config) *
+                               slope_speed_multiplier(terrain, config, pelvis.x, pelvis.z, s.heading);
+            }
             if (k == hold.first_tick) last_sample[h] = pelvis;
             else if ((k - hold.first_tick) % sample_every == 0 || k + 1 == hold.end_tick) {
                 const double dx = pelvis.x - last_sample[h].x, dz = pelvis.z - last_sample[h].z;

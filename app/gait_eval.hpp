@@ -3,14 +3,22 @@
 // a stick program and every metric is computed from the simulated joint
 // positions against the terrain, not from what the planner intended.
 #include <cstdint>
+#include <memory>
 #include <string>
 
+#include "runtime/motion_graph.hpp"
 #include "runtime/sim_config.hpp"
 #include "runtime/stick_program.hpp"
 
 namespace marionette {
 
+struct PuppetState;
+
 struct GaitMetrics {
+    // What drove the puppet: "gait" (the procedural gait) or "graph" (a motion graph).
+    std::string motion_source = "gait";
+    // Where speed_error_pct's expected speed comes from (docs/gait.md).
+    std::string speed_expectation = "gait response curve";
     double foot_skate_mm = 0.0;          // largest horizontal drift of a foot joint during one stance
     double penetration_mm = 0.0;         // deepest sole or toe point below the surface
     double speed_error_pct = 0.0;        // worst steady-state speed error over the program's holds
@@ -37,8 +45,21 @@ inline constexpr double kMaxJointSpeedDegS = 1500.0;
 // Empty when every limit holds, else which failed and by how much.
 std::string gait_limit_failures(const GaitMetrics& metrics);
 
+// Empty when every metric is a finite number, else the first that is not (the
+// only check `gait-eval --check --graph` applies: docs/gait.md).
+std::string gait_metric_non_finite(const GaitMetrics& metrics);
+
+// Whether foot 0 (left) or 1 (right) is planted in `state`, as the metrics read
+// stance: the gait's plan (not swinging) when the gait drives the puppet, the
+// graph controller's per-frame foot contacts when a motion graph does. The one
+// place that decides where stance comes from.
+bool foot_in_stance(const PuppetState& state, int foot);
+
 // `feet_csv`: when not empty, a per-tick CSV of both feet (swing flag, progress,
 // each sole point's height above the ground) is written there, for diagnosis.
-GaitMetrics evaluate_gait(const SimConfig& config, const StickProgram& program, const std::string& feet_csv = {});
+// `graph`: when given, the puppet is driven by it (attach_motion_graph, as
+// `--graph` on record/replay/run) and the metrics read the graph's feet.
+GaitMetrics evaluate_gait(const SimConfig& config, const StickProgram& program, const std::string& feet_csv = {},
+                          std::shared_ptr<const MotionGraph> graph = nullptr);
 
 }  // namespace marionette

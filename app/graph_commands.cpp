@@ -17,6 +17,7 @@
 #include "app/files.hpp"
 #include "render_es/image.hpp"
 #include "app/graph_files.hpp"
+#include "app/graph_rebuild.hpp"
 #include "app/json.hpp"
 #include "motion_graph/graph_builder.hpp"
 #include "render_es/image.hpp"
@@ -220,14 +221,11 @@ int graph_build_command(const GraphBuildCommandOptions& o) {
     if (o.clip_files.empty())
         throw ImportError("command line", 0, "graph build needs CLIPS (.bvh, or .amc with --asf), or --default");
     const SimConfig config = load_config(o.config_file);
-    const graph::LabelRules rules = o.labels_file.empty()
-                                        ? graph::parse_label_rules(std::string(embedded::find("config/graph_labels.toml")),
-                                                                   "config/graph_labels.toml")
-                                        : graph::parse_label_rules(read_text_file(o.labels_file), o.labels_file);
+    const GraphSources sources{o.asf_file, o.clip_files, o.labels_file};
     graph::GraphBuildParams params = graph_build_params(config);
     params.threads = o.threads;
     const auto started = std::chrono::steady_clock::now();
-    const graph::ClipDatabase db = graph::load_clip_database(o.clip_files, o.asf_file, rules, params.analysis_rate_hz);
+    const graph::ClipDatabase db = load_graph_sources(sources, params.analysis_rate_hz);
 
     graph::GraphBuildHooks hooks;
     const bool bar = isatty(fileno(stderr)) != 0;
@@ -240,20 +238,11 @@ int graph_build_command(const GraphBuildCommandOptions& o) {
             std::fflush(stderr);
         };
     if (!o.plot_file.empty()) hooks.plot_size = 1024;
-    graph::GraphBuildOutput out = graph::build_motion_graph(db, params, hooks);
+    graph::GraphBuildOutput out = build_graph_from_sources(db, sources, params, hooks);
     MotionGraph& g = out.graph;
-    g.source_asf = o.asf_file;
-    g.source_clips = db.source_files;
-    g.source_labels = o.labels_file;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     g.stats.build_seconds = seconds;
-    if (g.nodes.empty())
-        throw std::runtime_error(fmt::format(
-            "no strongly connected component: {} candidate transitions at threshold {:.4g} leave no cycle "
-            "(raise motion_graph.threshold_percentile)",
-            out.candidates.size(), out.threshold));
-    const std::vector<std::uint8_t> bytes = serialize_motion_graph(g);
-    write_binary_file(o.output_file, bytes);
+    write_binary_file_atomically(o.output_file, serialize_motion_graph(g));
     if (!o.plot_file.empty()) write_plot(o.plot_file, out);
     if (!o.dot_file.empty()) write_text_file(o.dot_file, dot_text(g));
 

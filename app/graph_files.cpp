@@ -5,6 +5,10 @@
 #include <fstream>
 #include <stdexcept>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "app/config.hpp"
 #include "app/default_graph.hpp"
 #include "app/files.hpp"
 
@@ -47,7 +51,33 @@ std::shared_ptr<const MotionGraph> load_graph_argument(const std::string& argume
     return std::make_shared<const MotionGraph>(load_motion_graph_file(argument));
 }
 
-void attach_motion_graph(Simulation& sim, std::shared_ptr<const MotionGraph> graph) {
+std::array<std::int32_t, kGraphActionButtons> resolve_graph_buttons(const SimConfig& config, const MotionGraph& graph,
+                                                                    const std::string& graph_name) {
+    static_assert(kButtonCount <= kGraphActionButtons, "every TickInput button needs a controller slot");
+    std::array<std::int32_t, kGraphActionButtons> out{};
+    out.fill(-1);
+    const auto defaults = default_graph_buttons();
+    const std::string labels = graph.labels.empty() ? std::string("none") : fmt::format("{}", fmt::join(graph.labels, ", "));
+    std::string unmapped;
+    for (std::size_t b = 0; b < kButtonNames.size(); ++b) {
+        const GraphButtonBinding& binding = config.graph_buttons[b];
+        if (binding.label.empty()) continue;
+        out[b] = graph.label_index(binding.label);
+        if (out[b] >= 0) continue;
+        const std::string key = "motion_graph.buttons." + std::string(kButtonNames[b]);
+        if (binding.label != defaults[b].label)
+            throw ConfigError(binding.file.empty() ? std::string("configuration") : binding.file, binding.line, key,
+                              "label '" + binding.label + "' is not in " + graph_name + " (its labels: " + labels +
+                                  "; or \"\" for none)");
+        unmapped += fmt::format("{}{} = \"{}\"", unmapped.empty() ? "" : ", ", kButtonNames[b], binding.label);
+    }
+    if (!unmapped.empty())
+        fmt::print(stderr, "warning: {} has no label for the default [motion_graph.buttons] {} (its labels: {}); those buttons do nothing\n",
+                   graph_name, unmapped, labels);
+    return out;
+}
+
+void attach_motion_graph(Simulation& sim, std::shared_ptr<const MotionGraph> graph, const std::string& graph_name) {
     const SimConfig& sim_config = sim.config();
     GraphControllerConfig config;
     const double leg = graph->leg_length > 0.0f ? graph->leg_length : 1.0;
@@ -58,8 +88,7 @@ void attach_motion_graph(Simulation& sim, std::shared_ptr<const MotionGraph> gra
     config.attract_after_s = sim_config.graph_attract_after_s;
     config.attract_temperature = sim_config.graph_attract_temperature;
     config.seed = static_cast<std::uint64_t>(sim_config.graph_attract_seed);
-    const char* const labels[4] = {"jump", "wave", "bow", "look_around"};
-    for (int b = 0; b < 4; ++b) config.button_label[static_cast<size_t>(b)] = graph->label_index(labels[b]);
+    config.button_label = resolve_graph_buttons(sim_config, *graph, graph_name);
     // A graph of the puppet's own skeleton (the default graph) is in the puppet's
     // metres already; any other is scaled so its leg is leg_metres long.
     const Skeleton& puppet = sim.skeleton();

@@ -1,6 +1,7 @@
 #pragma once
 // Motion-graph files for the commands: loading a .mgraph (errors name the file
 // and byte) and the build parameters a configuration gives.
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -23,10 +24,19 @@ std::shared_ptr<const MotionGraph> load_graph_argument(const std::string& argume
 void write_binary_file(const std::string& path, const std::vector<std::uint8_t>& bytes);
 graph::GraphBuildParams graph_build_params(const SimConfig& config);
 
-// Drives `sim` from `graph` (`--graph` on record, replay and run): the
+// [motion_graph.buttons] resolved against the graph's labels: button bit → label
+// index, −1 for none. A label the graph lacks is a ConfigError naming the key and
+// the file:line that set it, unless it is the key's shipped default: then one
+// warning line on stderr and the button does nothing (docs/config.md).
+std::array<std::int32_t, kGraphActionButtons> resolve_graph_buttons(const SimConfig& config, const MotionGraph& graph,
+                                                                    const std::string& graph_name);
+
+// Drives `sim` from `graph` (`--graph` on record, replay, run and gait-eval): the
 // controller's settings from the simulation's [motion_graph] keys (horizon, nodes
-// per tick, full-stick speed, leg scale, attract mode), and the face buttons south/east/west/north mapped to the labels
-// jump/wave/bow/look_around where the graph has them.
-void attach_motion_graph(Simulation& sim, std::shared_ptr<const MotionGraph> graph);
+// per tick, full-stick speed, leg scale, attract mode) and its buttons from
+// [motion_graph.buttons] (resolve_graph_buttons). `graph_name` names the graph in
+// messages.
+void attach_motion_graph(Simulation& sim, std::shared_ptr<const MotionGraph> graph,
+                         const std::string& graph_name = "the motion graph");
 
 }  // namespace marionette

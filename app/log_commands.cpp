@@ -6,6 +6,7 @@
 #include "app/config.hpp"
 #include "app/files.hpp"
 #include "app/graph_files.hpp"
+#include "app/graph_rebuild.hpp"
 #include "app/json.hpp"
 #include "app/program_source.hpp"
 #include "app/replay.hpp"
@@ -19,7 +20,8 @@ int record_command(const RecordOptions& o) {
 
     set_simulation_float_mode();
     Simulation sim(config);
-    if (auto graph = load_graph_argument(o.graph_file, config)) attach_motion_graph(sim, std::move(graph));
+    if (auto graph = load_graph_argument_rebuilding_stale(o.graph_file, config))
+        attach_motion_graph(sim, std::move(graph), o.graph_file.empty() ? "the default motion graph" : "graph " + o.graph_file);
     InputLogHeader header;
     header.tick_rate_hz = static_cast<std::uint32_t>(config.tick_rate_hz);
     header.clip_data_hash = sim.clip_data_hash();
@@ -51,6 +53,8 @@ int replay_command(const ReplayCommandOptions& o) {
     options.trace_csv = o.trace_csv;
     options.joints_csv = o.joints_csv;
     options.bvh = o.bvh;
+    // Never rebuilds a stale graph (unlike run/record): a rebuilt graph has other
+    // bytes than the one recorded, so the log's clip hash would refuse it.
     options.graph = load_graph_argument(
         o.graph_file, config_from_text(log.header.config_text, o.log_file + " (embedded configuration)"));
     const ReplayResult r = replay_log(log, o.log_file, options);

@@ -14,6 +14,7 @@
 #include "app/config.hpp"
 #include "app/files.hpp"
 #include "app/graph_files.hpp"
+#include "app/graph_rebuild.hpp"
 #include "app/json.hpp"
 #include "app/pipeline.hpp"
 #include "app/program_source.hpp"
@@ -191,7 +192,7 @@ int run_command(const RunOptions& o) {
     if (o.duration_s >= 0.0) p.total_ticks = static_cast<std::uint64_t>(o.duration_s * config.tick_rate_hz + 0.5);
 
     p.config = config;
-    p.graph = load_graph_argument(o.graph_file, config);
+    p.graph = load_graph_argument_rebuilding_stale(o.graph_file, config);
     p.virtual_time = o.fast;
     p.record_file = o.record_file;
     p.trace_file = o.trace_file;

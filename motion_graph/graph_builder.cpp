@@ -19,6 +19,16 @@ std::string describe_params(const GraphBuildParams& p) {
                        p.contact_speed);
 }
 
+std::uint64_t graph_source_hash(std::uint64_t content_hash, const GraphBuildParams& params) {
+    XXH64_state_t* h = XXH64_createState();
+    XXH64_reset(h, content_hash);
+    const std::string p = describe_params(params);
+    XXH64_update(h, p.data(), p.size());
+    const std::uint64_t hash = XXH64_digest(h);
+    XXH64_freeState(h);
+    return hash;
+}
+
 double skeleton_leg_length(const Skeleton& s, int foot) {
     double length = 0.0;
     if (foot >= 0) {
@@ -251,12 +261,7 @@ GraphBuildOutput build_motion_graph(const ClipDatabase& db, const GraphBuildPara
     }
 
 
-    XXH64_state_t* h = XXH64_createState();
-    XXH64_reset(h, db.content_hash);
-    const std::string p = describe_params(params);
-    XXH64_update(h, p.data(), p.size());
-    g.source_hash = XXH64_digest(h);
-    XXH64_freeState(h);
+    g.source_hash = graph_source_hash(db.content_hash, params);
 
     std::int64_t kept = 0;
     for (const GraphEdge& e : g.edges)

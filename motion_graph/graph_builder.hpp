@@ -30,6 +30,11 @@ struct GraphBuildParams {
 // Text of the parameters, hashed into the source hash.
 std::string describe_params(const GraphBuildParams& params);
 
+// The source hash a graph built from a database with this content hash and these
+// parameters carries (MotionGraph::source_hash): lets a caller tell whether a
+// .mgraph is stale without building.
+std::uint64_t graph_source_hash(std::uint64_t content_hash, const GraphBuildParams& params);
+
 struct GraphBuildOutput {
     MotionGraph graph;                 // pruned
     PruneReport prune;

@@ -2,17 +2,35 @@
 // Every tunable the simulation reads, as plain data. Loading, validation and the
 // documentation of each key live with the TOML schema (app/config.cpp,
 // docs/config.md); the defaults here are the ones config/marionette.toml states.
+#include <array>
 #include <cstdint>
 #include <string>
 
 #include "runtime/gait_prototype.hpp"
 #include "runtime/terrain.hpp"
+#include "runtime/tick_input.hpp"
 
 namespace marionette {
 
 // [motion] source: what poses the puppet. `automatic` is the motion graph when one
 // is attached (`--graph`), the gait otherwise.
 enum class MotionSourceSetting : std::int32_t { automatic = 0, gait = 1, graph = 2, graph_feet = 3 };
+// [motion_graph.buttons]: the graph label a button plays on press ("" for none),
+// and where the value came from, for the error when the graph lacks the label.
+struct GraphButtonBinding {
+    std::string label;
+    std::string file;           // configuration file that set it last
+    std::int32_t line = 0;      // 0: the built-in default
+};
+// Today's mapping: the face buttons play the default graph's actions.
+inline std::array<GraphButtonBinding, kButtonCount> default_graph_buttons() {
+    std::array<GraphButtonBinding, kButtonCount> b{};
+    b[static_cast<std::size_t>(Button::south)].label = "jump";
+    b[static_cast<std::size_t>(Button::east)].label = "wave";
+    b[static_cast<std::size_t>(Button::west)].label = "bow";
+    b[static_cast<std::size_t>(Button::north)].label = "look_around";
+    return b;
+}
 
 struct SimConfig {
     // [simulation]
@@ -103,6 +121,8 @@ struct SimConfig {
     float motion_crossfade_s = 0.4f;              // a live change of source cross-fades over this long
     float feet_release_s = 0.15f;                 // graph_feet: a lifted foot eases from its pin back to the clip
     float feet_terrain_rate = 10.0f;              // graph_feet: 1/s the body follows the ground height
+    // [motion_graph.buttons] button bit → label (runtime/tick_input.hpp kButtonNames order)
+    std::array<GraphButtonBinding, kButtonCount> graph_buttons = default_graph_buttons();
 };
 
 }  // namespace marionette

@@ -61,8 +61,8 @@ void hash_graph(XXH64_state_t* h, std::int32_t source, const GraphControllerStat
     XXH64_update(h, world, sizeof world);
     const float scalars[5] = {g.edge_position, g.idle_seconds, g.best_score, g.desired_vx, g.desired_vz};
     hash_floats(h, scalars, 5);
-    const std::int64_t counters[5] = {g.decisions, g.transitions_taken, g.actions_played, g.nodes_expanded,
-                                      static_cast<std::int64_t>(g.rng)};
+    const std::int64_t counters[6] = {g.decisions, g.transitions_taken, g.actions_played, g.nodes_expanded,
+                                      static_cast<std::int64_t>(g.rng), g.action_search_pops};
     XXH64_update(h, counters, sizeof counters);
     XXH64_update(h, g.action_path.data(), g.action_path.size() * sizeof(std::int32_t));
     for (const GraphSearchLevel& l : g.search) {

@@ -102,6 +102,8 @@ public:
     // True when the attached graph has the puppet's joints (names and parents), so
     // the gait and the graph can blend into each other.
     bool graph_matches_puppet() const { return graph_matches_puppet_; }
+    // Metres per graph unit of the attached graph's translations (1 without one).
+    double metres_per_unit() const { return metres_per_unit_; }
     // Why retune would refuse the [motion] source of `next` ("motion.source (…)"),
     // or "" when it would take it. Reads only what is fixed once the graph is
     // attached, so another thread may call it while step() runs.

@@ -1,0 +1,89 @@
+#include "app/graph_rebuild.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+#include "app/embedded.hpp"
+#include "app/files.hpp"
+#include "app/graph_files.hpp"
+
+namespace marionette {
+
+graph::ClipDatabase load_graph_sources(const GraphSources& s, double analysis_rate_hz) {
+    const graph::LabelRules rules =
+        s.labels.empty()
+            ? graph::parse_label_rules(std::string(embedded::find("config/graph_labels.toml")), "config/graph_labels.toml")
+            : graph::parse_label_rules(read_text_file(s.labels), s.labels);
+    return graph::load_clip_database(s.clips, s.asf, rules, analysis_rate_hz);
+}
+
+graph::GraphBuildOutput build_graph_from_sources(const graph::ClipDatabase& db, const GraphSources& s,
+                                                 const graph::GraphBuildParams& params,
+                                                 const graph::GraphBuildHooks& hooks) {
+    graph::GraphBuildOutput out = graph::build_motion_graph(db, params, hooks);
+    MotionGraph& g = out.graph;
+    g.source_asf = s.asf;
+    g.source_clips = db.source_files;
+    g.source_labels = s.labels;
+    if (g.nodes.empty())
+        throw std::runtime_error(fmt::format(
+            "no strongly connected component: {} candidate transitions at threshold {:.4g} leave no cycle "
+            "(raise motion_graph.threshold_percentile)",
+            out.candidates.size(), out.threshold));
+    return out;
+}
+
+void write_binary_file_atomically(const std::string& path, const std::vector<std::uint8_t>& bytes) {
+    const std::string temp = path + fmt::format(".tmp{}", static_cast<long>(getpid()));
+    write_binary_file(temp, bytes);
+    std::error_code ec;
+    std::filesystem::rename(temp, path, ec);
+    if (ec) {
+        std::filesystem::remove(temp);
+        throw std::runtime_error(path + ": cannot replace the file: " + ec.message());
+    }
+}
+
+std::shared_ptr<const MotionGraph> load_graph_argument_rebuilding_stale(const std::string& argument,
+                                                                        const SimConfig& config) {
+    if (argument.empty() || argument == "default") return load_graph_argument(argument, config);
+    const std::vector<std::uint8_t> bytes = read_binary_file(argument);
+    const std::uint64_t stored_hash = motion_graph_source_hash(bytes, argument);  // header only: cheap
+    auto graph = std::make_shared<MotionGraph>(deserialize_motion_graph(bytes, argument));
+    if (graph->source_clips.empty()) return graph;  // nothing recorded to rebuild from
+    const GraphSources sources{graph->source_asf, graph->source_clips, graph->source_labels};
+    std::vector<std::string> missing;
+    std::error_code ec;
+    const auto check = [&](const std::string& path) {
+        if (!path.empty() && !std::filesystem::is_regular_file(path, ec)) missing.push_back(path);
+    };
+    check(sources.asf);
+    for (const std::string& c : sources.clips) check(c);
+    check(sources.labels);
+    if (!missing.empty()) {
+        fmt::print(stderr, "warning: {}: {} of its source files {} missing (first: {}); using the graph as it is, "
+                           "unchecked for staleness\n",
+                   argument, missing.size(), missing.size() == 1 ? "is" : "are", missing.front());
+        return graph;
+    }
+    graph::GraphBuildParams params = graph_build_params(config);
+    const auto started = std::chrono::steady_clock::now();
+    const graph::ClipDatabase db = load_graph_sources(sources, params.analysis_rate_hz);
+    const std::uint64_t current_hash = graph::graph_source_hash(db.content_hash, params);
+    if (current_hash == stored_hash) return graph;
+    graph::GraphBuildOutput out = build_graph_from_sources(db, sources, params);
+    out.graph.stats.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    write_binary_file_atomically(argument, serialize_motion_graph(out.graph));
+    fmt::print(stderr, "{}: stale (source hash {:016x}, its {} source files and the [motion_graph] build parameters now hash "
+                       "{:016x}): rebuilt in {:.2f} s and written back\n",
+               argument, stored_hash, sources.clips.size() + (sources.asf.empty() ? 0 : 1) + (sources.labels.empty() ? 0 : 1),
+               current_hash, out.graph.stats.build_seconds);
+    return std::make_shared<const MotionGraph>(std::move(out.graph));
+}
+
+}  // namespace marionette
