@@ -52,7 +52,9 @@ const char* const kActionPaths[] = {"config/clips/wave.bvh", "config/clips/bow.b
 Clip capture(const SimConfig& config, const LocomotionProgram& p, double rate_hz) {
     const StickProgram program = parse_stick_program(p.program, std::string("default graph program ") + p.name);
     const std::vector<TickInput> inputs = render_stick_program(program, config.tick_rate_hz);
-    Simulation sim(config);
+    // Always on flat ground: the graph's clips are terrain-free (graph_feet adapts
+    // them), and the default graph must not change with the configured terrain.
+    Simulation sim(config, Terrain{});
     const Skeleton& skeleton = sim.skeleton();
     const int joints = skeleton.joint_count();
     const double tick_s = 1.0 / config.tick_rate_hz;

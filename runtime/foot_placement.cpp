@@ -57,15 +57,33 @@ void FootPlacementJob::run() const {
     FootPlacementState& s = *state;
     const vec3 up(0.0f, 1.0f, 0.0f);
 
-    // The body follows the lower of the grounds under the two ankles.
-    float ground[2];
+    // Each foot's ground: under it, or higher just ahead of it; eased, so a step
+    // up lifts the foot over a few ticks instead of at once.
     GroundSample sample[2];
+    bool slow[2];
     for (int i = 0; i < 2; ++i) {
+        FootPin& pin = s.feet[static_cast<size_t>(i)];
         const vec3 a = model_positions[static_cast<size_t>(rig->legs[static_cast<size_t>(i)].ankle)];
         sample[i] = query_ground(*terrain, a.x, a.z);
-        ground[i] = sample[i].height;
+        const vec3 moved = s.started ? a - pin.clip_previous : vec3(0.0f);
+        const float step = std::sqrt(moved.x * moved.x + moved.z * moved.z);
+        slow[i] = !(dt > 0.0f) || step <= kPinMaxSpeed * dt;
+        float wanted = sample[i].height;
+        if (step > 1e-6f) {
+            const float ahead = max_height_along(*terrain, a.x, a.z, a.x + moved.x / step * kFootLookAheadM,
+                                                 a.z + moved.z / step * kFootLookAheadM, 0.05f);
+            wanted = ahead > wanted ? ahead : wanted;
+        }
+        if (!s.started || pin.contact == 1) pin.ground = sample[i].height;
+        else {
+            const float limit = kFootGroundSpeed * dt;
+            const float change = wanted - pin.ground;
+            pin.ground += change > limit ? limit : (change < -limit ? -limit : change);
+        }
+        pin.clip_previous = a;
     }
-    const float lowest = ground[0] < ground[1] ? ground[0] : ground[1];
+    // The body follows the lower of the two feet's grounds.
+    const float lowest = s.feet[0].ground < s.feet[1].ground ? s.feet[0].ground : s.feet[1].ground;
     if (!s.started) s.body_offset = lowest;
     else s.body_offset += (lowest - s.body_offset) * clamp01(terrain_rate * dt);
     const size_t root = static_cast<size_t>(rig->root);
@@ -79,8 +97,8 @@ void FootPlacementJob::run() const {
         const size_t hip = static_cast<size_t>(leg.hip), knee = static_cast<size_t>(leg.knee),
                      ankle = static_cast<size_t>(leg.ankle);
         // The clip's ankle, as high above the ground under it as it was above its flat floor.
-        const vec3 free = model_positions[ankle] + vec3(0.0f, ground[i] - s.body_offset, 0.0f);
-        const bool contact = (contacts >> i) & 1u;
+        const vec3 free = model_positions[ankle] + vec3(0.0f, pin.ground - s.body_offset, 0.0f);
+        const bool contact = ((contacts >> i) & 1u) && slow[i];
         if (contact && pin.contact == 0) {
             pin.pin = s.started ? pin.placed : free;
             pin.contact = 1;

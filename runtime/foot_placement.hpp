@@ -4,9 +4,13 @@
 // slide the feet a little, so
 //   - the body is raised to the ground under the feet (the lower of the two, so
 //     the other leg bends to reach its higher ground), following at a rate;
-//   - each foot the clip marks in contact is pinned where it touched down and
-//     held there by the two-bone IK until the clip lifts it; then it eases back to
-//     the clip's own path, placed above the ground under it;
+//   - each foot the clip marks in contact, and that the clip moves slower than
+//     kPinMaxSpeed, is pinned where it touched down and held there by the two-bone
+//     IK until the clip lifts it; then it eases back to the clip's own path;
+//   - a foot is placed on its own ground height, which eases (at most
+//     kFootGroundSpeed) toward the highest ground under it and up to
+//     kFootLookAheadM ahead of it, so a foot rises onto a step before its toes
+//     reach the riser, not at it;
 //   - a planted foot tilts to the ground's normal.
 // A job in the ozz style: plain state in, spans in and out, no allocation. The
 // legs are found by joint index (hip = knee's parent, knee = ankle's parent),
@@ -24,6 +28,8 @@ namespace marionette {
 struct FootPin {
     vec3 pin{0.0f};              // where the ankle is held while the clip's foot is in contact (world, m)
     vec3 placed{0.0f};           // where the ankle was put last tick: a new pin starts there, so nothing jumps
+    vec3 clip_previous{0.0f};    // the clip's ankle last tick (world, before placement): its speed
+    float ground = 0.0f;         // ground height the foot is placed on, eased toward the ground ahead of it
     float release = 1.0f;        // 0 held at the pin … 1 following the clip's foot
     std::int32_t contact = 0;    // 0 free, 1 pinned, 2 in contact but let go (the pin slipped too far from the clip)
 };
@@ -51,6 +57,14 @@ FootPlacementRig make_foot_placement_rig(std::span<const int> parents, int left_
 // A pin that drifts this far (horizontally) from the clip's foot is let go, so a
 // long blend cannot stretch the leg out of reach.
 inline constexpr float kMaxPinSlipM = 0.25f;
+// The clip's contact flags come from thresholds loose enough for any capture; a
+// foot the clip still moves faster than this (m/s, on the ground plane) is not pinned.
+inline constexpr float kPinMaxSpeed = 0.35f;
+// How fast (m/s) a foot's ground height may change, and how far ahead (m) of the
+// ankle, along its motion, the highest ground is looked for: past the toes of an
+// adult foot, so the toes clear a riser the ankle has not reached.
+inline constexpr float kFootGroundSpeed = 3.0f;
+inline constexpr float kFootLookAheadM = 0.35f;
 
 struct FootPlacementJob {
     FootPlacementState* state = nullptr;
