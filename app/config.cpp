@@ -78,6 +78,10 @@ const KeySpec kKeys[] = {
     {"motion_graph", "attract_after_s", &SimConfig::graph_attract_after_s, 0.1, 86400.0, "seconds without input before the attract-mode random walk"},
     {"motion_graph", "attract_temperature", &SimConfig::graph_attract_temperature, 0.001, 1000.0, "attract walk: edge weight 1 / (1 + cost / temperature)"},
     {"motion_graph", "attract_seed", &SimConfig::graph_attract_seed, 0, 2147483647, "attract-mode random seed"},
+    // [motion]: what poses the puppet (docs/motion-graph.md, "Motion sources"); `source` is kMotionSourceNames.
+    {"motion", "crossfade_s", &SimConfig::motion_crossfade_s, 0.0, 5.0, "a live change of motion source cross-fades over this long (s)"},
+    {"motion", "feet_release_s", &SimConfig::feet_release_s, 0.0, 2.0, "graph_feet: a lifted foot eases from its pin back to the clip's foot (s)"},
+    {"motion", "feet_terrain_rate", &SimConfig::feet_terrain_rate, 0.1, 100.0, "graph_feet: how fast the body follows the ground height (1/s)"},
     // [gait] (docs/gait.md); the prototypes are [gait.walk] and [gait.run], below.
     {"gait", "pelvis_height", &SimConfig::gait_pelvis_height, 0.3, 2.0, "hip height above the mean foot ground while stepping (m)"},
     {"gait", "step_length_multiplier", &SimConfig::step_length_multiplier, 0.05, 2.0, "step length = multiplier · sqrt(speed)"},
@@ -96,6 +100,11 @@ const KeySpec kKeys[] = {
     {"gait", "breath_amplitude", &SimConfig::breath_amplitude, 0.0, 0.05, "pelvis rise of a breath when idle (m)"},
     {"gait", "breath_period_s", &SimConfig::breath_period_s, 0.5, 20.0, "length of one breath (s)"},
 };
+
+// [motion] source, the one string-valued key; the names index MotionSourceSetting.
+constexpr const char* kMotionSourceNames[] = {"auto", "gait", "graph", "graph_feet"};
+
+void apply_motion_source(SimConfig& config, const toml::node& node, const std::string& file);
 
 int line_of(const toml::node& node) { return static_cast<int>(node.source().begin.line); }
 
@@ -261,6 +270,7 @@ std::vector<ConfigKeyInfo> config_schema() {
     std::vector<ConfigKeyInfo> out;
     for (const KeySpec& k : kKeys)
         out.push_back({k.table, k.key, std::holds_alternative<IntField>(k.field) ? "integer" : "float", k.min, k.max, k.doc});
+    out.push_back({"motion", "source", "string", 0, 0, "what poses the puppet: auto, gait, graph or graph_feet"});
     for (const std::string_view b : kButtonNames)
         out.push_back({"motion_graph.buttons", std::string(b), "string", 0.0, 0.0, "graph label played when the button is pressed, \"\" for none"});
     return out;
@@ -289,6 +299,10 @@ SimConfig apply_config_text(const SimConfig& base, std::string_view text, const 
         }
         for (const auto& [key, node] : *table) {
             const std::string full = table_name + "." + std::string(key.str());
+            if (table_name == "motion" && key.str() == "source") {
+                apply_motion_source(config, node, file);
+                continue;
+            }
             if (table_name == "motion_graph" && key.str() == "buttons") {
                 apply_buttons_table(config, node, file);
                 continue;
@@ -336,6 +350,24 @@ SimConfig apply_config_text(const SimConfig& base, std::string_view text, const 
     return config;
 }
 
+namespace {
+void apply_motion_source(SimConfig& config, const toml::node& node, const std::string& file) {
+    const auto* s = node.as_string();
+    for (std::size_t i = 0; s && i < std::size(kMotionSourceNames); ++i)
+        if (s->get() == kMotionSourceNames[i]) {
+            config.motion_source = static_cast<MotionSourceSetting>(i);
+            return;
+        }
+    throw ConfigError(file, line_of(node), "motion.source",
+                      (s ? "'" + s->get() + "' is not a motion source" : std::string("expected a string")) +
+                          " (expected \"auto\", \"gait\", \"graph\" or \"graph_feet\")");
+}
+}  // namespace
+
+std::string motion_source_name(MotionSourceSetting source) {
+    return kMotionSourceNames[static_cast<std::size_t>(source)];
+}
+
 std::string_view default_config_text() { return embedded::find("config/marionette.toml"); }
 
 SimConfig default_config() { return apply_config_text(SimConfig{}, default_config_text(), "config/marionette.toml"); }
@@ -353,6 +385,7 @@ std::string serialize_config(const SimConfig& config) {
         if (table != k.table) {
             table = k.table;
             out += "\n[" + table + "]\n";
+            if (table == "motion") out += "source = " + toml_string(motion_source_name(config.motion_source)) + "\n";
         }
         out += std::string(k.key) + " = ";
         if (std::holds_alternative<IntField>(k.field))

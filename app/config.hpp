@@ -31,7 +31,7 @@ private:
 struct ConfigKeyInfo {
     std::string table;
     std::string key;       // without the table
-    std::string type;      // "integer" or "float"
+    std::string type;      // "integer", "float" or "string" (min and max unused)
     double min = 0.0;
     double max = 0.0;
     std::string doc;
@@ -39,6 +39,9 @@ struct ConfigKeyInfo {
 
 // Every key the configuration accepts, in the order the effective text lists them.
 std::vector<ConfigKeyInfo> config_schema();
+
+// "auto", "gait", "graph" or "graph_feet", as [motion] source spells it.
+std::string motion_source_name(MotionSourceSetting source);
 
 // Applies the TOML text on top of `base`. Throws ConfigError.
 SimConfig apply_config_text(const SimConfig& base, std::string_view toml_text, const std::string& file_name);

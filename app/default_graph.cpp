@@ -26,21 +26,24 @@ struct LocomotionProgram {
     double keep_from_s;
 };
 
-// Stick conventions (runtime/stick_program.hpp): ly up is forward; a circle with
-// positive turns sweeps the stick from up toward left, so the puppet turns left.
+// Stick conventions (runtime/stick_program.hpp): ly up walks toward −Z, but the
+// puppet starts facing +Z, so the programs push the stick down (ly < 0): every clip
+// then walks the way it faces from the start, and no start turns on the spot. A
+// circle with positive turns sweeps the stick counter-clockwise (down → right here:
+// toward +X, the puppet's left), so the puppet turns left.
 const LocomotionProgram kLocomotion[] = {
     {"idle", "hold 4s\n", 0.0},
-    {"walk_slow", "ramp 500ms ly=0.35\nhold 4.5s\n", 2.0},
-    {"walk", "ramp 500ms ly=0.5\nhold 4.5s\n", 2.0},
-    {"walk_brisk", "ramp 500ms ly=0.7\nhold 4s\n", 2.0},
-    {"run", "ramp 500ms ly=1\nhold 4s\n", 2.0},
-    {"walk_turn_left", "ramp 500ms ly=0.5\nhold 1.5s\ncircle 3s radius=0.5 turns=0.25 from=90\nhold 1s\n", 1.5},
-    {"walk_turn_right", "ramp 500ms ly=0.5\nhold 1.5s\ncircle 3s radius=0.5 turns=-0.25 from=90\nhold 1s\n", 1.5},
-    {"run_turn_left", "ramp 500ms ly=1\nhold 1.5s\ncircle 2.5s radius=1 turns=0.25 from=90\nhold 1s\n", 1.5},
-    {"run_turn_right", "ramp 500ms ly=1\nhold 1.5s\ncircle 2.5s radius=1 turns=-0.25 from=90\nhold 1s\n", 1.5},
+    {"walk_slow", "ramp 500ms ly=-0.35\nhold 4.5s\n", 2.0},
+    {"walk", "ramp 500ms ly=-0.5\nhold 4.5s\n", 2.0},
+    {"walk_brisk", "ramp 500ms ly=-0.7\nhold 4s\n", 2.0},
+    {"run", "ramp 500ms ly=-1\nhold 4s\n", 2.0},
+    {"walk_turn_left", "ramp 500ms ly=-0.5\nhold 1.5s\ncircle 3s radius=0.5 turns=0.25 from=270\nhold 1s\n", 1.5},
+    {"walk_turn_right", "ramp 500ms ly=-0.5\nhold 1.5s\ncircle 3s radius=0.5 turns=-0.25 from=270\nhold 1s\n", 1.5},
+    {"run_turn_left", "ramp 500ms ly=-1\nhold 1.5s\ncircle 2.5s radius=1 turns=0.25 from=270\nhold 1s\n", 1.5},
+    {"run_turn_right", "ramp 500ms ly=-1\nhold 1.5s\ncircle 2.5s radius=1 turns=-0.25 from=270\nhold 1s\n", 1.5},
     // Start from standing and stop again: the idle ↔ walk/run links.
-    {"idle_walk_stop", "hold 1s\nramp 500ms ly=0.5\nhold 2.5s\nramp 300ms ly=0\nhold 2.5s\n", 0.0},
-    {"idle_run_stop", "hold 1s\nramp 500ms ly=1\nhold 2.5s\nramp 300ms ly=0\nhold 2.5s\n", 0.0},
+    {"idle_walk_stop", "hold 1s\nramp 500ms ly=-0.5\nhold 2.5s\nramp 300ms ly=0\nhold 2.5s\n", 0.0},
+    {"idle_run_stop", "hold 1s\nramp 500ms ly=-1\nhold 2.5s\nramp 300ms ly=0\nhold 2.5s\n", 0.0},
 };
 
 const char* const kActionPaths[] = {"config/clips/wave.bvh", "config/clips/bow.bvh", "config/clips/jump.bvh",

@@ -132,7 +132,8 @@ std::vector<Hold> moving_holds(const StickProgram& program, const SimConfig& c) 
 }  // namespace
 
 bool foot_in_stance(const PuppetState& s, int foot) {
-    if (s.motion_source == 1) return (s.graph.contacts & (foot == 0 ? kContactLeft : kContactRight)) != 0;
+    // graph and graph_feet: the clip's contacts (graph_feet pins exactly those feet).
+    if (s.motion_source != kSourceGait) return (s.graph.contacts & (foot == 0 ? kContactLeft : kContactRight)) != 0;
     return s.gait.feet[static_cast<std::size_t>(foot)].swinging == 0;
 }
 
@@ -172,18 +173,19 @@ GaitMetrics evaluate_gait(const SimConfig& config, const StickProgram& program, 
     FootGeometry feet[2] = {puppet_foot(kFootL), puppet_foot(kFootR)};
     // Expected speed with a graph: the controller asks for stick deflection ×
     // full_stick_speed leg lengths per second (no deadzone, curve or slope factor),
-    // and a leg is scaled to leg_metres (attach_motion_graph).
-    const double graph_full_speed_m_s = static_cast<double>(config.graph_full_stick_speed) * config.graph_leg_metres;
+    // in metres as attach_motion_graph scales the graph (graph_metres_per_unit).
+    double graph_full_speed_m_s = 0.0;
     if (graph) {
         if (graph->left_foot < 0 || graph->right_foot < 0)
             throw std::runtime_error("the motion graph names no left and right foot joints, so the foot metrics cannot be measured");
         const double leg = graph->leg_length > 0.0f ? graph->leg_length : 1.0;
-        const double metres_per_unit = config.graph_leg_metres / leg;
+        const double metres_per_unit = graph_metres_per_unit(*graph, sim.skeleton(), config);
+        graph_full_speed_m_s = static_cast<double>(config.graph_full_stick_speed) * leg * metres_per_unit;
         feet[0] = graph_foot(*graph, graph->left_foot, metres_per_unit);
         feet[1] = graph_foot(*graph, graph->right_foot, metres_per_unit);
         attach_motion_graph(sim, graph);
         m.motion_source = "graph";
-        m.speed_expectation = "graph full_stick_speed x leg_metres x stick deflection";
+        m.speed_expectation = "graph full_stick_speed x leg length in metres x stick deflection";
     }
     const std::size_t pelvis_joint = graph ? 0 : static_cast<std::size_t>(kPelvis);
 

@@ -33,9 +33,11 @@ int gait_eval_command(const GaitEvalOptions& o) {
         config.terrain_name = o.terrain;
     }
     const StickProgram program = load_program(o.program);
-    const bool with_graph = !o.graph_file.empty();
-    const GaitMetrics m =
-        evaluate_gait(config, program, o.feet_csv, with_graph ? load_graph_argument(o.graph_file, config) : nullptr);
+    // As on record/run: --graph, or the default graph when [motion] source asks for one.
+    std::shared_ptr<const MotionGraph> graph = load_graph_argument(o.graph_file, config);
+    const bool with_graph = graph != nullptr;
+    const std::string graph_name = o.graph_file.empty() ? std::string("default") : o.graph_file;
+    const GaitMetrics m = evaluate_gait(config, program, o.feet_csv, std::move(graph));
     // The limits are the procedural gait's (docs/gait.md). A graph plays captured
     // motion without contact pinning yet, so with --graph the metrics are reported
     // and only a metric that is not a finite number fails --check.
@@ -45,13 +47,13 @@ int gait_eval_command(const GaitEvalOptions& o) {
                    "\"penetration_mm\":{},\"speed_error_pct\":{},\"speed_expectation\":{},\"speed_windows\":{},"
                    "\"max_joint_speed_deg_s\":{},\"steps\":{},\"flight_phases\":{},\"final_hash\":\"{:016x}\",\"limits_ok\":{}}}\n",
                    json::quote(config.terrain_name), json::quote(o.program), json::quote(m.motion_source),
-                   with_graph ? json::quote(o.graph_file) : std::string("null"), m.ticks, json::number(m.foot_skate_mm),
+                   with_graph ? json::quote(graph_name) : std::string("null"), m.ticks, json::number(m.foot_skate_mm),
                    json::number(m.penetration_mm), json::number(m.speed_error_pct), json::quote(m.speed_expectation),
                    m.speed_windows, json::number(m.max_joint_speed_deg_s), m.steps, m.flight_phases, m.final_hash,
                    with_graph ? "null" : failures.empty() ? "true" : "false");
     } else {
         fmt::print("gait-eval: {} on {} ({} ticks, motion from {})\n", o.program, config.terrain_name, m.ticks,
-                   with_graph ? "graph " + o.graph_file : std::string("the gait"));
+                   with_graph ? "graph " + graph_name : std::string("the gait"));
         if (with_graph) fmt::print("  (the gait's limits are not applied to a graph; speed expected from {})\n", m.speed_expectation);
         fmt::print("  foot_skate_mm          {:10.4f}  (limit < {}; worst at tick {})\n", m.foot_skate_mm, kMaxFootSkateMm, m.skate_tick);
         fmt::print("  penetration_mm         {:10.4f}  (limit < {}; deepest: {} at tick {})\n", m.penetration_mm,

@@ -18,6 +18,8 @@ MotionGraph load_motion_graph_file(const std::string& path);
 // `--graph` on record, replay and run: a .mgraph file, or "default" for the
 // embedded default graph built from the configuration's [motion_graph]
 // parameters (identical bytes every time, so a log recorded with it replays with it).
+// An empty argument gives the default graph when the configuration's [motion]
+// source is graph or graph_feet, and no graph (nullptr) otherwise.
 std::shared_ptr<const MotionGraph> load_graph_argument(const std::string& argument, const SimConfig& config);
 void write_binary_file(const std::string& path, const std::vector<std::uint8_t>& bytes);
 graph::GraphBuildParams graph_build_params(const SimConfig& config);
@@ -28,6 +30,11 @@ graph::GraphBuildParams graph_build_params(const SimConfig& config);
 // warning line on stderr and the button does nothing (docs/config.md).
 std::array<std::int32_t, kGraphActionButtons> resolve_graph_buttons(const SimConfig& config, const MotionGraph& graph,
                                                                     const std::string& graph_name);
+
+// Metres per graph unit when a graph drives a puppet with skeleton `puppet`: 1 for
+// a graph of the puppet's own skeleton (the default graph), else leg_metres / the
+// graph's leg length.
+double graph_metres_per_unit(const MotionGraph& graph, const Skeleton& puppet, const SimConfig& config);
 
 // Drives `sim` from `graph` (`--graph` on record, replay, run and gait-eval): the
 // controller's settings from the simulation's [motion_graph] keys (horizon, nodes

@@ -51,7 +51,7 @@ void write_binary_file_atomically(const std::string& path, const std::vector<std
 
 std::shared_ptr<const MotionGraph> load_graph_argument_rebuilding_stale(const std::string& argument,
                                                                         const SimConfig& config) {
-    if (argument == "default") return load_graph_argument(argument, config);
+    if (argument.empty() || argument == "default") return load_graph_argument(argument, config);
     const std::vector<std::uint8_t> bytes = read_binary_file(argument);
     const std::uint64_t stored_hash = motion_graph_source_hash(bytes, argument);  // header only: cheap
     auto graph = std::make_shared<MotionGraph>(deserialize_motion_graph(bytes, argument));

@@ -20,8 +20,8 @@ int record_command(const RecordOptions& o) {
 
     set_simulation_float_mode();
     Simulation sim(config);
-    if (!o.graph_file.empty())
-        attach_motion_graph(sim, load_graph_argument_rebuilding_stale(o.graph_file, config), "graph " + o.graph_file);
+    if (auto graph = load_graph_argument_rebuilding_stale(o.graph_file, config))
+        attach_motion_graph(sim, std::move(graph), o.graph_file.empty() ? "the default graph" : "graph " + o.graph_file);
     InputLogHeader header;
     header.tick_rate_hz = static_cast<std::uint32_t>(config.tick_rate_hz);
     header.clip_data_hash = sim.clip_data_hash();
@@ -55,9 +55,8 @@ int replay_command(const ReplayCommandOptions& o) {
     options.bvh = o.bvh;
     // Never rebuilds a stale graph (unlike run/record): a rebuilt graph has other
     // bytes than the one recorded, so the log's clip hash would refuse it.
-    if (!o.graph_file.empty())
-        options.graph = load_graph_argument(
-            o.graph_file, config_from_text(log.header.config_text, o.log_file + " (embedded configuration)"));
+    options.graph = load_graph_argument(
+        o.graph_file, config_from_text(log.header.config_text, o.log_file + " (embedded configuration)"));
     const ReplayResult r = replay_log(log, o.log_file, options);
     if (o.json) {
         fmt::print("{{\"log\":{},\"ticks\":{},\"tick_rate_hz\":{},\"duration_s\":{},\"final_hash\":\"{:016x}\","

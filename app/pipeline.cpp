@@ -413,6 +413,9 @@ std::string realtime_change(const SimConfig& a, const SimConfig& b) {
 struct LiveTuning {
     std::unique_ptr<ConfigWatcher> watcher;
     SimConfig published;       // the newest configuration handed over
+    // Only its fixed-after-start part is read (motion_source_refusal), so this
+    // thread may ask it while the simulation thread steps.
+    const Simulation* simulation = nullptr;
     std::uint32_t version = 0;
     // Every configuration handed over, by version − 1: the simulation names the
     // one it applied and the writer logs it (edits come at human pace).
@@ -429,6 +432,7 @@ struct LiveTuning {
         }
         std::string key = structural_change(published, next);
         if (key.empty()) key = realtime_change(published, next);
+        if (key.empty() && simulation) key = simulation->motion_source_refusal(next);
         if (!key.empty()) {
             fmt::print(err, "config: {}: {} cannot change while running (restart to apply it); keeping the previous configuration\n",
                        watcher->path(), key);
@@ -484,6 +488,7 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
     }
     LiveTuning tuning;
     tuning.published = config;
+    tuning.simulation = &loop->simulation();
     if (!o.watch_config_file.empty()) tuning.watcher = std::make_unique<ConfigWatcher>(o.watch_config_file);
 
     std::string realtime_failed;

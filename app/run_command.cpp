@@ -192,7 +192,7 @@ int run_command(const RunOptions& o) {
     if (o.duration_s >= 0.0) p.total_ticks = static_cast<std::uint64_t>(o.duration_s * config.tick_rate_hz + 0.5);
 
     p.config = config;
-    if (!o.graph_file.empty()) p.graph = load_graph_argument_rebuilding_stale(o.graph_file, config);
+    p.graph = load_graph_argument_rebuilding_stale(o.graph_file, config);
     p.virtual_time = o.fast;
     p.record_file = o.record_file;
     p.trace_file = o.trace_file;

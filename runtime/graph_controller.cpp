@@ -1,6 +1,10 @@
 #include "runtime/graph_controller.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <functional>
 #include <stdexcept>
+#include <utility>
 
 #include "runtime/det_math.hpp"
 
@@ -17,6 +21,44 @@ std::uint64_t next_random(std::uint64_t& state) {
     return z ^ (z >> 31);
 }
 double random_unit(std::uint64_t& state) { return static_cast<double>(next_random(state) >> 11) * (1.0 / 9007199254740992.0); }
+
+constexpr float kUnreachableSeconds = 1e9f;
+// Past this the heuristic stops growing: it only has to point the way.
+constexpr double kHeuristicCapSeconds = 4.0;
+// Per second still to go, it outweighs a full facing error (2) over a one-second horizon.
+constexpr double kHeuristicWeight = 2.5;
+
+// Seconds (edge_cost) from every node to the nearest goal node: Dijkstra on the
+// reversed edges (construction time, allocates).
+std::vector<float> seconds_to_goals(const MotionGraph& g, const std::vector<char>& goal, double transition_weight) {
+    const size_t n = g.nodes.size();
+    std::vector<std::vector<std::pair<std::int32_t, double>>> incoming(n);
+    for (const GraphEdge& e : g.edges)
+        incoming[static_cast<size_t>(e.to)].push_back({e.from, edge_cost(g, e, transition_weight)});
+    std::vector<double> best(n, static_cast<double>(kUnreachableSeconds));
+    using Item = std::pair<double, std::int32_t>;
+    std::vector<Item> heap;
+    for (size_t i = 0; i < n; ++i)
+        if (goal[i]) best[i] = 0.0, heap.push_back({0.0, static_cast<std::int32_t>(i)});
+    std::make_heap(heap.begin(), heap.end(), std::greater<Item>());
+    while (!heap.empty()) {
+        std::pop_heap(heap.begin(), heap.end(), std::greater<Item>());
+        const Item top = heap.back();
+        heap.pop_back();
+        if (top.first > best[static_cast<size_t>(top.second)]) continue;
+        for (const auto& [from, cost] : incoming[static_cast<size_t>(top.second)]) {
+            const double d = top.first + cost;
+            if (d < best[static_cast<size_t>(from)]) {
+                best[static_cast<size_t>(from)] = d;
+                heap.push_back({d, from});
+                std::push_heap(heap.begin(), heap.end(), std::greater<Item>());
+            }
+        }
+    }
+    std::vector<float> out(n);
+    for (size_t i = 0; i < n; ++i) out[i] = static_cast<float>(best[i]);
+    return out;
+}
 }  // namespace
 
 GraphController::GraphController(const MotionGraph& graph, const GraphControllerConfig& config)
@@ -38,6 +80,22 @@ GraphController::GraphController(const MotionGraph& graph, const GraphController
         const vec3 forward = quat_rotate(graph.rotations[f * joints + static_cast<size_t>(root)], vec3(0.0f, 0.0f, 1.0f));
         frame_yaw_[f] = static_cast<float>(det::atan2(forward.x, forward.z));
     }
+    // Ground speed of the root at each node's frame (over the next frame of its clip).
+    std::vector<char> moving(graph.nodes.size(), 0), still(graph.nodes.size(), 0);
+    for (size_t n = 0; n < graph.nodes.size(); ++n) {
+        const GraphNode& node = graph.nodes[n];
+        const GraphClip& clip = graph.clips[static_cast<size_t>(node.clip)];
+        const int a = std::min(node.frame, clip.frame_count - 2), b = a + 1;
+        if (a < 0) continue;
+        const vec3 pa = graph.translations[static_cast<size_t>(clip.first_frame + a) * joints + static_cast<size_t>(root)];
+        const vec3 pb = graph.translations[static_cast<size_t>(clip.first_frame + b) * joints + static_cast<size_t>(root)];
+        const double dx = pb.x - pa.x, dz = pb.z - pa.z;
+        const double speed = std::sqrt(dx * dx + dz * dz) * graph.frame_rate;
+        moving[n] = speed > 0.35 * config.max_speed;
+        still[n] = speed < 0.1 * config.max_speed;
+    }
+    seconds_to_moving_ = seconds_to_goals(graph, moving, config.transition_weight);
+    seconds_to_still_ = seconds_to_goals(graph, still, config.transition_weight);
 }
 
 int GraphController::clip_edge_of(int node) const {
@@ -132,6 +190,21 @@ void GraphController::search_run(GraphControllerState& s, int budget) const {
     const double desired_heading = steering ? det::atan2(s.desired_vx, s.desired_vz) : root_heading(origin.node, origin_world);
     const double scale = config_.max_speed * config_.horizon_s;
     const double inv_scale2 = scale > 0.0 ? 1.0 / (scale * scale) : 1.0;
+    // A leaf's score: where the root ends up against where the stick's velocity
+    // would have put it by then, the facing error, and the transitions' cost.
+    auto score_leaf = [&](int node, const PlanarTransform& world, double seconds, double cost, int first_edge) {
+        const vec3 p = root_position(node, world);
+        const double ex = p.x - (p0.x + s.desired_vx * seconds);
+        const double ez = p.z - (p0.z + s.desired_vz * seconds);
+        const double heading_error = 1.0 - det::cos(root_heading(node, world) - desired_heading);
+        const float to_goal = (steering ? seconds_to_moving_ : seconds_to_still_)[static_cast<size_t>(node)];
+        const double beyond = kHeuristicWeight * std::min(static_cast<double>(to_goal), kHeuristicCapSeconds) ;
+        const double score = (ex * ex + ez * ez) * inv_scale2 + config_.heading_weight * heading_error + cost + beyond;
+        if (s.best_edge < 0 || score < s.best_score) {
+            s.best_edge = first_edge;
+            s.best_score = static_cast<float>(score);
+        }
+    };
     while (budget > 0 && s.search_depth >= 0) {
         GraphSearchLevel& level = s.search[static_cast<size_t>(s.search_depth)];
         const std::span<const GraphEdge> out = graph_.out_edges(level.node);
@@ -157,19 +230,31 @@ void GraphController::search_run(GraphControllerState& s, int budget) const {
         child.cost = level.cost + static_cast<float>(config_.transition_weight * e.cost);
         PlanarTransform world = placement(level.angle, level.dx, level.dz);
         if (e.kind == GraphEdgeKind::transition) world = compose_planar(world, edge_alignment(e));
-        child.angle = world.angle, child.dx = world.dx, child.dz = world.dz;
         // Bound: the other terms are never negative, so the cost so far bounds the score.
         if (s.best_edge >= 0 && child.cost >= s.best_score) continue;
-        if (child.seconds >= config_.horizon_s || s.search_depth + 1 >= kGraphSearchDepth) {
-            const vec3 p = root_position(child.node, world);
-            const double ex = p.x - (p0.x + s.desired_vx * child.seconds);
-            const double ez = p.z - (p0.z + s.desired_vz * child.seconds);
-            const double heading_error = 1.0 - det::cos(root_heading(child.node, world) - desired_heading);
-            const double score = (ex * ex + ez * ez) * inv_scale2 + config_.heading_weight * heading_error + child.cost;
-            if (s.best_edge < 0 || score < s.best_score) {
-                s.best_edge = child.first_edge;
-                s.best_score = static_cast<float>(score);
+        if (s.search_depth + 1 >= config_.branch_depth || s.search_depth + 1 >= kGraphSearchDepth) {
+            // Past the branching levels the clip plays on: follow its clip edges to
+            // the horizon (a clip is cut into many short edges at its transition
+            // points, so counting them as levels would stop well short of it).
+            // Each edge followed counts against the budget; a roll-out is at most
+            // kGraphRolloutEdges long, so a tick's work stays bounded.
+            int node = child.node;
+            double seconds = child.seconds;
+            for (int followed = 0; seconds < config_.horizon_s && followed < kGraphRolloutEdges; ++followed) {
+                int next = clip_edge_of(node);
+                if (next < 0) break;  // the clip ends here: score where it stops
+                const GraphEdge& c = graph_.edges[static_cast<size_t>(next)];
+                seconds += c.frames / graph_.frame_rate;
+                node = c.to;
+                --budget;
+                ++s.nodes_expanded;
             }
+            score_leaf(node, world, seconds, child.cost, child.first_edge);
+            continue;
+        }
+        child.angle = world.angle, child.dx = world.dx, child.dz = world.dz;
+        if (child.seconds >= config_.horizon_s) {
+            score_leaf(child.node, world, child.seconds, child.cost, child.first_edge);
             continue;
         }
         s.search[static_cast<size_t>(++s.search_depth)] = child;

@@ -28,6 +28,7 @@ namespace marionette {
 inline constexpr int kGraphSearchDepth = 8;     // edges looked ahead at most
 inline constexpr int kGraphActionPath = 64;     // edges of a path to an action clip
 inline constexpr int kGraphActionButtons = 16;  // TickInput button bits
+inline constexpr int kGraphRolloutEdges = 64;   // clip edges a search leaf follows toward the horizon at most
 
 struct GraphControllerConfig {
     double horizon_s = 1.0;             // look-ahead of the locomotion search
@@ -126,6 +127,11 @@ private:
     std::vector<quat> rot_a_, rot_b_;
     std::vector<vec3> tra_a_, tra_b_;
     std::vector<float> frame_yaw_;  // per database frame: root facing in clip coordinates
+    // Per node: seconds (path cost) to the nearest node where the root moves at
+    // walking speed, and to the nearest where it stands still. The look-ahead sees
+    // only `horizon_s`; these tell it which way the rest of the graph lies (from an
+    // idle clip, walking may be several transitions away).
+    std::vector<float> seconds_to_moving_, seconds_to_still_;
 };
 
 }  // namespace marionette

@@ -29,6 +29,10 @@ inline std::array<GraphButtonBinding, kButtonCount> default_graph_buttons() {
     return b;
 }
 
+// [motion] source: what poses the puppet. `automatic` is the motion graph when one
+// is attached (`--graph`), the gait otherwise.
+enum class MotionSourceSetting : std::int32_t { automatic = 0, gait = 1, graph = 2, graph_feet = 3 };
+
 struct SimConfig {
     // [simulation]
     std::int32_t tick_rate_hz = 240;
@@ -114,6 +118,12 @@ struct SimConfig {
     std::int32_t graph_attract_seed = 1;          // attract-mode PRNG seed
     // [motion_graph.buttons] button bit → label (runtime/tick_input.hpp kButtonNames order)
     std::array<GraphButtonBinding, kButtonCount> graph_buttons = default_graph_buttons();
+    // [motion] which source poses the puppet, and how a change of source blends
+    // (docs/motion-graph.md, "Motion sources")
+    MotionSourceSetting motion_source = MotionSourceSetting::automatic;
+    float motion_crossfade_s = 0.4f;              // a live change of source cross-fades over this long
+    float feet_release_s = 0.15f;                 // graph_feet: a lifted foot eases from its pin back to the clip
+    float feet_terrain_rate = 10.0f;              // graph_feet: 1/s the body follows the ground height
 };
 
 }  // namespace marionette
