@@ -184,7 +184,9 @@ GaitMetrics evaluate_gait(const SimConfig& config, const StickProgram& program, 
         feet[0] = graph_foot(*graph, graph->left_foot, metres_per_unit);
         feet[1] = graph_foot(*graph, graph->right_foot, metres_per_unit);
         attach_motion_graph(sim, graph);
-        m.motion_source = "graph";
+        // What [motion] source resolved to with the graph attached.
+        const std::int32_t source = sim.state().motion_source;
+        m.motion_source = source == kSourceGraphFeet ? "graph_feet" : source == kSourceGait ? "gait" : "graph";
         m.speed_expectation = "graph full_stick_speed x leg length in metres x stick deflection";
     }
     const std::size_t pelvis_joint = graph ? 0 : static_cast<std::size_t>(kPelvis);
