@@ -77,6 +77,14 @@ std::array<std::int32_t, kGraphActionButtons> resolve_graph_buttons(const SimCon
     return out;
 }
 
+double graph_metres_per_unit(const MotionGraph& graph, const Skeleton& puppet, const SimConfig& config) {
+    // A graph of the puppet's own skeleton (the default graph) is in the puppet's
+    // metres already; any other is scaled so its leg is leg_metres long.
+    const bool puppet_skeleton = graph.skeleton.joint_names == puppet.joint_names && graph.skeleton.parents == puppet.parents;
+    const double leg = graph.leg_length > 0.0f ? graph.leg_length : 1.0;
+    return puppet_skeleton ? 1.0 : config.graph_leg_metres / leg;
+}
+
 void attach_motion_graph(Simulation& sim, std::shared_ptr<const MotionGraph> graph, const std::string& graph_name) {
     const SimConfig& sim_config = sim.config();
     GraphControllerConfig config;
@@ -89,11 +97,7 @@ void attach_motion_graph(Simulation& sim, std::shared_ptr<const MotionGraph> gra
     config.attract_temperature = sim_config.graph_attract_temperature;
     config.seed = static_cast<std::uint64_t>(sim_config.graph_attract_seed);
     config.button_label = resolve_graph_buttons(sim_config, *graph, graph_name);
-    // A graph of the puppet's own skeleton (the default graph) is in the puppet's
-    // metres already; any other is scaled so its leg is leg_metres long.
-    const Skeleton& puppet = sim.skeleton();
-    const bool puppet_skeleton = graph->skeleton.joint_names == puppet.joint_names && graph->skeleton.parents == puppet.parents;
-    const double metres_per_unit = puppet_skeleton ? 1.0 : sim_config.graph_leg_metres / leg;
+    const double metres_per_unit = graph_metres_per_unit(*graph, sim.skeleton(), sim_config);
     sim.use_motion_graph(std::move(graph), config, metres_per_unit);
 }
 

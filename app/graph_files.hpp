@@ -31,6 +31,11 @@ graph::GraphBuildParams graph_build_params(const SimConfig& config);
 std::array<std::int32_t, kGraphActionButtons> resolve_graph_buttons(const SimConfig& config, const MotionGraph& graph,
                                                                     const std::string& graph_name);
 
+// Metres per graph unit when a graph drives a puppet with skeleton `puppet`: 1 for
+// a graph of the puppet's own skeleton (the default graph), else leg_metres / the
+// graph's leg length.
+double graph_metres_per_unit(const MotionGraph& graph, const Skeleton& puppet, const SimConfig& config);
+
 // Drives `sim` from `graph` (`--graph` on record, replay, run and gait-eval): the
 // controller's settings from the simulation's [motion_graph] keys (horizon, nodes
 // per tick, full-stick speed, leg scale, attract mode) and its buttons from

@@ -35,7 +35,8 @@ graph::GraphBuildOutput build_graph_from_sources(const graph::ClipDatabase& db, 
 // so a reader never sees a half-written file.
 void write_binary_file_atomically(const std::string& path, const std::vector<std::uint8_t>& bytes);
 
-// `--graph` on run and record: like load_graph_argument, but a .mgraph whose
+// `--graph` on run and record: like load_graph_argument (empty or "default": just
+// that), but a .mgraph whose
 // recorded sources all exist and now hash differently (clips or labels edited,
 // or the configuration's [motion_graph] build parameters changed) is rebuilt
 // from them with the current parameters and written back atomically, with one

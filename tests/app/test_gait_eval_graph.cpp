@@ -16,18 +16,25 @@ using namespace marionette;
 
 TEST_CASE("gait-eval: stance is the gait's plan, or the graph's foot contacts with a graph", "[gait_eval]") {
     PuppetState s;
-    s.motion_source = 0;
+    s.motion_source = kSourceGait;
     s.gait.feet[0].swinging = 0;
     s.gait.feet[1].swinging = 1;
     s.graph.contacts = kContactRight;  // ignored while the gait drives
     CHECK(foot_in_stance(s, 0));
     CHECK_FALSE(foot_in_stance(s, 1));
-    s.motion_source = 1;  // now the contacts decide, whatever the gait state says
+    s.motion_source = kSourceGraph;  // now the contacts decide, whatever the gait state says
     CHECK_FALSE(foot_in_stance(s, 0));
     CHECK(foot_in_stance(s, 1));
     s.graph.contacts = kContactLeft | kContactRight;
     CHECK(foot_in_stance(s, 0));
     CHECK(foot_in_stance(s, 1));
+    // graph_feet: the pins decide (a foot in contact but let go for slipping is not planted).
+    s.motion_source = kSourceGraphFeet;
+    s.graph.contacts = kContactLeft | kContactRight;
+    s.feet.feet[0].contact = 1;
+    s.feet.feet[1].contact = 2;
+    CHECK(foot_in_stance(s, 0));
+    CHECK_FALSE(foot_in_stance(s, 1));
 }
 
 TEST_CASE("gait-eval: a walk on the default motion graph gives finite metrics from the graph's feet", "[gait_eval]") {
