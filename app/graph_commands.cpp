@@ -246,7 +246,6 @@ int graph_build_command(const GraphBuildCommandOptions& o) {
     g.source_clips = db.source_files;
     g.source_labels = o.labels_file;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    g.stats.build_seconds = seconds;
     if (g.nodes.empty())
         throw std::runtime_error(fmt::format(
             "no strongly connected component: {} candidate transitions at threshold {:.4g} leave no cycle "
