@@ -109,7 +109,7 @@ TEST_CASE("local minima on synthetic matrices", "[graph][minima]") {
     CHECK(local_minima(m, n, n, 2, 1e9).size() == 1);
 }
 
-TEST_CASE("the tiled sgemm search finds the same candidates as the reference", "[graph][distance]") {
+TEST_CASE("the tiled dgemm search finds the same candidates as the reference", "[graph][distance]") {
     // With capture-like noise: exactly periodic motion has valleys flat to 1e-7,
     // below float resolution, where any rounding picks a different minimum.
     const ClipDatabase db = synthetic_database(0.05);
