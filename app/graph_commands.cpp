@@ -241,7 +241,12 @@ int graph_build_command(const GraphBuildCommandOptions& o) {
     graph::GraphBuildOutput out = build_graph_from_sources(db, sources, params, hooks);
     MotionGraph& g = out.graph;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    g.stats.build_seconds = seconds;
+    if (g.nodes.empty())
+        throw std::runtime_error(fmt::format(
+            "no strongly connected component: {} candidate transitions at threshold {:.4g} leave no cycle "
+            "(raise motion_graph.threshold_percentile)",
+            out.candidates.size(), out.threshold));
+    // build_seconds stays 0 in the file (same build, same bytes); --json reports it.
     write_binary_file_atomically(o.output_file, serialize_motion_graph(g));
     if (!o.plot_file.empty()) write_plot(o.plot_file, out);
     if (!o.dot_file.empty()) write_text_file(o.dot_file, dot_text(g));

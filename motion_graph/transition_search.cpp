@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 #include <thread>
 
 namespace marionette::graph {
@@ -28,7 +29,8 @@ inline double distance_from_sums(const FrameFeatures& f, std::int32_t i, std::in
     const size_t ui = static_cast<size_t>(i), ug = static_cast<size_t>(g);
     const double dot = sum_dot, cross = sum_cross;
     const double d = f.window_spread[ui] + f.window_spread[ug] - 2.0 * sum_y - 2.0 * std::sqrt(dot * dot + cross * cross);
-    return d > 0.0 ? d / (f.weight * k) : 0.0;
+    const double v = d / (f.weight * k);
+    return v > kDistanceNoiseFloor ? v : 0.0;
 }
 
 // +inf, −1 (near-diagonal) or 0 (a pair to evaluate).
@@ -123,11 +125,11 @@ FrameFeatures compute_frame_features(const ClipDatabase& db, std::span<const vec
         for (size_t j = 0; j < J; ++j) {
             const double qx = sqrt_w[j] * (p[j].x * inv_scale - f.cx[fr]), qz = sqrt_w[j] * (p[j].z * inv_scale - f.cz[fr]);
             const double qy = sqrt_w[j] * (p[j].y * inv_scale);
-            f.xz[fr * width + j] = static_cast<float>(qx);
-            f.xz[fr * width + J + j] = static_cast<float>(qz);
-            f.zx[fr * width + j] = static_cast<float>(qz);
-            f.zx[fr * width + J + j] = static_cast<float>(-qx);
-            f.y[fr * J + j] = static_cast<float>(qy);
+            f.xz[fr * width + j] = qx;
+            f.xz[fr * width + J + j] = qz;
+            f.zx[fr * width + j] = qz;
+            f.zx[fr * width + J + j] = -qx;
+            f.y[fr * J + j] = qy;
             s += qx * qx + qz * qz + qy * qy;
         }
         spread[fr] = s;
@@ -163,22 +165,6 @@ FrameFeatures compute_frame_features(const ClipDatabase& db, std::span<const vec
         f.window_cz[s] = sz;
         f.window_spread[s] = sum + f.weight * (cc - (sx * sx + sz * sz) / window);
     }
-    // Window features: the frame centroids' offsets from their window's mean, so the
-    // centroid part of the cross terms is one exact-enough float product per pair.
-    const double sqrt_weight = std::sqrt(f.weight);
-    f.window_dot.assign(n * 2 * k, 0.0f);
-    f.window_cross.assign(n * 2 * k, 0.0f);
-    for (size_t s = 0; s < n; ++s) {
-        if (!f.start_ok[s]) continue;
-        const double mx = f.window_cx[s] / window, mz = f.window_cz[s] / window;
-        for (size_t t = 0; t < k; ++t) {
-            const double dx = sqrt_weight * (f.cx[s + t] - mx), dz = sqrt_weight * (f.cz[s + t] - mz);
-            f.window_dot[s * 2 * k + t] = static_cast<float>(dx);
-            f.window_dot[s * 2 * k + k + t] = static_cast<float>(dz);
-            f.window_cross[s * 2 * k + t] = static_cast<float>(dz);
-            f.window_cross[s * 2 * k + k + t] = static_cast<float>(-dx);
-        }
-    }
     return f;
 }
 
@@ -192,16 +178,21 @@ double feature_pair_distance(const FrameFeatures& f, std::int32_t i, std::int32_
         const size_t a = static_cast<size_t>(i + t), b = static_cast<size_t>(g + t);
         const size_t width = 2 * J;
         for (size_t q = 0; q < width; ++q) {
-            sd += static_cast<double>(f.xz[a * width + q]) * f.xz[b * width + q];
-            sc += static_cast<double>(f.xz[a * width + q]) * f.zx[b * width + q];
+            sd += f.xz[a * width + q] * f.xz[b * width + q];
+            sc += f.xz[a * width + q] * f.zx[b * width + q];
         }
-        for (size_t q = 0; q < J; ++q) sy += static_cast<double>(f.y[a * J + q]) * f.y[b * J + q];
+        for (size_t q = 0; q < J; ++q) sy += f.y[a * J + q] * f.y[b * J + q];
     }
-    const size_t w2 = 2 * static_cast<size_t>(f.window), ui = static_cast<size_t>(i), ug = static_cast<size_t>(g);
-    for (size_t q = 0; q < w2; ++q) {
-        sd += static_cast<double>(f.window_dot[ui * w2 + q]) * f.window_dot[ug * w2 + q];
-        sc += static_cast<double>(f.window_dot[ui * w2 + q]) * f.window_cross[ug * w2 + q];
+    // The centroids' part: W·(Σ_t c_a·c_b − ΣA·ΣB / k), as the tiled search adds it.
+    double cd = 0.0, cc = 0.0;
+    for (int t = 0; t < f.window; ++t) {
+        const size_t a = static_cast<size_t>(i + t), b = static_cast<size_t>(g + t);
+        cd += f.cx[a] * f.cx[b] + f.cz[a] * f.cz[b];
+        cc += f.cx[a] * f.cz[b] - f.cz[a] * f.cx[b];
     }
+    const size_t ui = static_cast<size_t>(i), ug = static_cast<size_t>(g);
+    sd += f.weight * cd - f.weight / f.window * (f.window_cx[ui] * f.window_cx[ug] + f.window_cz[ui] * f.window_cz[ug]);
+    sc += f.weight * cc - f.weight / f.window * (f.window_cx[ui] * f.window_cz[ug] - f.window_cz[ui] * f.window_cx[ug]);
     return distance_from_sums(f, i, g, sd, sc, sy);
 }
 
@@ -270,27 +261,135 @@ std::vector<double> distance_percentiles(const FrameFeatures& f, const std::vect
 
 namespace {
 
-// dst[c] += src[c]: kept as its own loop so it vectorises.
-__attribute__((noinline)) void add_row(float* __restrict dst, const float* __restrict src, std::int32_t n) {
-    for (std::int32_t c = 0; c < n; ++c) dst[c] += src[c];
-}
-
 // out[r][c] = row (a_first + r) of `a` · row (b_first + c) of `b`, r < a_rows,
 // c < b_rows, rows `width` floats long: every cross term of a tile is one sgemm.
-void row_dots(const float* a, std::int32_t a_first, std::int32_t a_rows, const float* b, std::int32_t b_first,
-              std::int32_t b_rows, int width, float* out) {
-    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, a_rows, b_rows, width, 1.0f,
+void row_dots(const double* a, std::int32_t a_first, std::int32_t a_rows, const double* b, std::int32_t b_first,
+              std::int32_t b_rows, int width, double* out) {
+    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasTrans, a_rows, b_rows, width, 1.0,
                 a + static_cast<size_t>(a_first) * static_cast<size_t>(width), width,
-                b + static_cast<size_t>(b_first) * static_cast<size_t>(width), width, 0.0f, out, b_rows);
+                b + static_cast<size_t>(b_first) * static_cast<size_t>(width), width, 0.0, out, b_rows);
 }
 
+// The per-row kernels of a tile are cloned for wider vector units where the
+// compiler can (the same IEEE adds, multiplies and square roots in the same order
+// per lane, and no contraction: every clone gives the same bits).
+#if defined(__x86_64__) && defined(__has_attribute)
+#if __has_attribute(target_clones)
+#define MARIONETTE_VECTOR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+#endif
+#ifndef MARIONETTE_VECTOR_CLONES
+#define MARIONETTE_VECTOR_CLONES
+#endif
+
+// The five window sums of a tile row, in double, each [c] for pair column c:
+// dot, cross and y cross terms (from the sgemm products) and the dot and cross
+// products of the frame centroids.
+enum WindowSum { kSumDot, kSumCross, kSumY, kSumCentroidDot, kSumCentroidCross, kSumCount };
+
+struct TileTerms {
+    const double* dot;   // [nr][nc] per-frame cross terms (dgemm)
+    const double* cross;
+    const double* y;
+    const double* row_cx;  // frame centroids of the tile's rows (nr) and columns (nc)
+    const double* row_cz;
+    const double* col_cx;
+    const double* col_cz;
+    size_t nc;
+};
+
+// Row r's sums from row r − 1's: pair (r, c)'s k-frame diagonal is pair
+// (r − 1, c − 1)'s with frame pair (r + k − 1, c + k − 1) entering and
+// (r − 1, c − 1) leaving. Double sums of float products are exact to ~1e-16, so
+// (the products are doubles: sliding along 500 diagonal steps costs ~1e-13). Columns c ≥ 1 only.
+MARIONETTE_VECTOR_CLONES void slide_window_sums(const TileTerms& m, std::int32_t r, std::int32_t k, std::int32_t dc,
+                                                const double* __restrict prev, double* __restrict cur) {
+    const size_t in = static_cast<size_t>(r + k - 1) * m.nc + static_cast<size_t>(k - 1);
+    const size_t out = static_cast<size_t>(r - 1) * m.nc;
+    const size_t n = static_cast<size_t>(dc);
+    const double* __restrict dot_in = m.dot + in;
+    const double* __restrict dot_out = m.dot + out;
+    const double* __restrict cross_in = m.cross + in;
+    const double* __restrict cross_out = m.cross + out;
+    const double* __restrict y_in = m.y + in;
+    const double* __restrict y_out = m.y + out;
+    for (size_t c = 1; c < n; ++c) {
+        cur[c] = prev[c - 1] + dot_in[c] - dot_out[c - 1];
+        cur[n + c] = prev[n + c - 1] + cross_in[c] - cross_out[c - 1];
+        cur[2 * n + c] = prev[2 * n + c - 1] + y_in[c] - y_out[c - 1];
+    }
+    const double ex = m.row_cx[r + k - 1], ez = m.row_cz[r + k - 1], lx = m.row_cx[r - 1], lz = m.row_cz[r - 1];
+    const double* __restrict cx_in = m.col_cx + (k - 1);
+    const double* __restrict cz_in = m.col_cz + (k - 1);
+    const double* __restrict cx_out = m.col_cx;
+    const double* __restrict cz_out = m.col_cz;
+    for (size_t c = 1; c < n; ++c) {
+        cur[3 * n + c] = prev[3 * n + c - 1] + (ex * cx_in[c] + ez * cz_in[c]) - (lx * cx_out[c - 1] + lz * cz_out[c - 1]);
+        cur[4 * n + c] = prev[4 * n + c - 1] + (ex * cz_in[c] - ez * cx_in[c]) - (lx * cz_out[c - 1] - lz * cx_out[c - 1]);
+    }
+}
+
+// The window sums of pair (r, c) summed directly over its k frames.
+void direct_window_sums(const TileTerms& m, std::int32_t r, std::int32_t c, std::int32_t k, std::int32_t dc, double* sums) {
+    const size_t n = static_cast<size_t>(dc), uc = static_cast<size_t>(c);
+    double s[kSumCount] = {};
+    for (std::int32_t t = 0; t < k; ++t) {
+        const size_t a = static_cast<size_t>(r + t), b = static_cast<size_t>(c + t);
+        const size_t at = a * m.nc + b;
+        s[kSumDot] += m.dot[at];
+        s[kSumCross] += m.cross[at];
+        s[kSumY] += m.y[at];
+        s[kSumCentroidDot] += m.row_cx[a] * m.col_cx[b] + m.row_cz[a] * m.col_cz[b];
+        s[kSumCentroidCross] += m.row_cx[a] * m.col_cz[b] - m.row_cz[a] * m.col_cx[b];
+    }
+    for (int q = 0; q < kSumCount; ++q) sums[static_cast<size_t>(q) * n + uc] = s[q];
+}
+
+struct RowWindow {
+    double spread;    // Σ w|p − centroid|² of window A
+    double sum_x, sum_z;  // Σ_t centroid of window A
+};
+
+// Distances of one tile row from its window sums, in double, rounded to float
+// once (as the reference's are): dot and cross are the frames' centred terms plus
+// the centroids' part W·(Σ c_a·c_b − ΣA·ΣB / k); D = S_A + S_B − 2Y − 2√(dot² + cross²).
+// col_x, col_z: W/k · Σ_t centroid of each column's window B.
+MARIONETTE_VECTOR_CLONES void window_distances(const double* __restrict sums, std::int32_t dc, RowWindow a, double weight,
+                                               double inv_wk, const double* __restrict col_spread,
+                                               const double* __restrict col_x, const double* __restrict col_z,
+                                               float* __restrict out) {
+    const size_t n = static_cast<size_t>(dc);
+    for (size_t c = 0; c < n; ++c) {
+        const double dot = sums[c] + (weight * sums[3 * n + c] - (a.sum_x * col_x[c] + a.sum_z * col_z[c]));
+        const double cross = sums[n + c] + (weight * sums[4 * n + c] - (a.sum_x * col_z[c] - a.sum_z * col_x[c]));
+        const double d = a.spread + col_spread[c] - 2.0 * sums[2 * n + c] - 2.0 * std::sqrt(dot * dot + cross * cross);
+        const double v = d * inv_wk;
+        out[c] = static_cast<float>(v > kDistanceNoiseFloor ? v : 0.0);
+    }
+}
+
+// A scratch array that grows but is never value-initialised: the tile buffers are
+// megabytes, every cell is written (dgemm with beta 0, the distance rows) before
+// it is read, and zero-filling them at every size change cost as much as the dgemm.
+template <typename T>
+struct ScratchArray {
+    std::unique_ptr<T[]> data_;
+    size_t size_ = 0;
+    void ensure(size_t n) {
+        if (n > size_) data_.reset(new T[n]), size_ = n;
+    }
+    T* data() { return data_.get(); }
+    const T* data() const { return data_.get(); }
+    T& operator[](size_t i) { return data_[i]; }
+};
+
 struct TileScratch {
-    std::vector<float> ca, cb, cy;        // per-frame cross terms of the tile
-    std::vector<float> sa, sb, sy;        // one row of k-frame diagonal window sums
-    std::vector<float> wa, wb;            // window-centroid terms of the tile's pairs
-    std::vector<float> col_spread;        // window spread of each column's window
+    ScratchArray<double> ca, cb, cy;      // per-frame cross terms of the tile (dgemm)
+    std::vector<double> row_cx, row_cz, col_cx, col_cz;  // frame centroids of its rows and columns
+    std::vector<double> sums[2];          // window sums of the previous and the current row
+    std::vector<double> col_spread, col_x, col_z;  // per column's window B
     std::vector<std::int32_t> invalid_cols;
-    std::vector<float> d;                 // distances of the tile plus halo
+    ScratchArray<float> d;                // distances of the tile plus halo
     std::vector<TransitionCandidate> found;
     std::vector<float> plot;
     std::int64_t evaluations = 0;
@@ -309,71 +408,62 @@ void run_tile(const FrameFeatures& f, const CandidateSearchOptions& o, std::int3
     const std::int32_t row0 = ei0, col0 = ej0 - k + 1;
     const int J = f.joints, width = 2 * J;
     const size_t cells = static_cast<size_t>(nr) * static_cast<size_t>(nc);
-    s.ca.resize(cells);
-    s.cb.resize(cells);
-    s.cy.resize(cells);
+    s.ca.ensure(cells);
+    s.cb.ensure(cells);
+    s.cy.ensure(cells);
     // Cross terms of every frame pair of the tile: C[r][c] = frame (row0+r) · frame (col0+c).
     row_dots(f.xz.data(), row0, nr, f.xz.data(), col0, nc, width, s.ca.data());
     row_dots(f.xz.data(), row0, nr, f.zx.data(), col0, nc, width, s.cb.data());
     row_dots(f.y.data(), row0, nr, f.y.data(), col0, nc, J, s.cy.data());
 
     const std::int32_t dr = ei1 - ei0, dc = ej1 - ej0;
-    const int w2 = 2 * k;
-    s.wa.resize(static_cast<size_t>(dr) * static_cast<size_t>(dc));
-    s.wb.resize(static_cast<size_t>(dr) * static_cast<size_t>(dc));
-    row_dots(f.window_dot.data(), ei0, dr, f.window_dot.data(), col0, dc, w2, s.wa.data());
-    row_dots(f.window_dot.data(), ei0, dr, f.window_cross.data(), col0, dc, w2, s.wb.data());
+    s.row_cx.assign(f.cx.begin() + row0, f.cx.begin() + row0 + nr);
+    s.row_cz.assign(f.cz.begin() + row0, f.cz.begin() + row0 + nr);
+    s.col_cx.assign(f.cx.begin() + col0, f.cx.begin() + col0 + nc);
+    s.col_cz.assign(f.cz.begin() + col0, f.cz.begin() + col0 + nc);
+    const TileTerms terms{s.ca.data(), s.cb.data(), s.cy.data(), s.row_cx.data(), s.row_cz.data(),
+                          s.col_cx.data(), s.col_cz.data(), static_cast<size_t>(nc)};
 
-    // Window sums: pair (i, j) needs Σ_t C[r+t][c+t] with r = i − ei0, c = j − ej0
-    // (its k cells along one diagonal). Row by row, adding the k shifted rows is
-    // contiguous in c, so it vectorises.
-    s.d.resize(static_cast<size_t>(dr) * static_cast<size_t>(dc));
-    s.sa.resize(static_cast<size_t>(dc));
-    s.sb.resize(static_cast<size_t>(dc));
-    s.sy.resize(static_cast<size_t>(dc));
-    s.col_spread.resize(static_cast<size_t>(dc));
+    // Per column: window B's spread and W/k · Σ centroid; columns whose window leaves its clip.
+    const size_t udc = static_cast<size_t>(dc);
+    s.col_spread.resize(udc);
+    s.col_x.resize(udc);
+    s.col_z.resize(udc);
     s.invalid_cols.clear();
+    const double w_over_k = f.weight / k;
     for (std::int32_t c = 0; c < dc; ++c) {
-        s.col_spread[static_cast<size_t>(c)] = static_cast<float>(f.window_spread[static_cast<size_t>(col0 + c)]);
+        const size_t g = static_cast<size_t>(col0 + c);
+        s.col_spread[static_cast<size_t>(c)] = f.window_spread[g];
+        s.col_x[static_cast<size_t>(c)] = w_over_k * f.window_cx[g];
+        s.col_z[static_cast<size_t>(c)] = w_over_k * f.window_cz[g];
         if (!f.end_ok[static_cast<size_t>(ej0 + c)]) s.invalid_cols.push_back(c);
     }
+    // Window sums row by row: row 0 and column 0 directly, the rest by sliding along
+    // the diagonals (two double adds per sum and pair instead of k).
+    s.d.ensure(static_cast<size_t>(dr) * udc);
+    s.sums[0].resize(kSumCount * udc);
+    s.sums[1].resize(kSumCount * udc);
     const double inv_wk = 1.0 / (f.weight * k);
     for (std::int32_t r = 0; r < dr; ++r) {
-        float* __restrict sa = s.sa.data();
-        float* __restrict sb = s.sb.data();
-        float* __restrict sy = s.sy.data();
-        std::fill(sa, sa + dc, 0.0f);
-        std::fill(sb, sb + dc, 0.0f);
-        std::fill(sy, sy + dc, 0.0f);
-        for (std::int32_t t = 0; t < k; ++t) {
-            const size_t base = static_cast<size_t>(r + t) * static_cast<size_t>(nc) + static_cast<size_t>(t);
-            const float* __restrict ra = s.ca.data() + base;
-            const float* __restrict rb = s.cb.data() + base;
-            const float* __restrict ry = s.cy.data() + base;
-            add_row(sa, ra, dc);
-            add_row(sb, rb, dc);
-            add_row(sy, ry, dc);
+        double* cur = s.sums[static_cast<size_t>(r & 1)].data();
+        const double* prev = s.sums[static_cast<size_t>((r + 1) & 1)].data();
+        if (r == 0) {
+            for (std::int32_t c = 0; c < dc; ++c) direct_window_sums(terms, 0, c, k, dc, cur);
+        } else {
+            direct_window_sums(terms, r, 0, k, dc, cur);
+            slide_window_sums(terms, r, k, dc, prev, cur);
         }
         const std::int32_t i = ei0 + r;
         const size_t ui = static_cast<size_t>(i);
-        float* __restrict out = s.d.data() + static_cast<size_t>(r) * static_cast<size_t>(dc);
+        float* __restrict out = s.d.data() + static_cast<size_t>(r) * udc;
         if (!f.start_ok[ui]) {
             std::fill(out, out + dc, kPairInvalid);
             continue;
         }
         // Branch-free over the row (it vectorises); invalid and near-diagonal pairs
         // are patched afterwards from short lists.
-        const float ua = static_cast<float>(f.window_spread[ui]);
-        const float* __restrict wa = s.wa.data() + static_cast<size_t>(r) * static_cast<size_t>(dc);
-        const float* __restrict wb = s.wb.data() + static_cast<size_t>(r) * static_cast<size_t>(dc);
-        const float* __restrict ub = s.col_spread.data();
-        const float scale = static_cast<float>(inv_wk);
-        for (std::int32_t c = 0; c < dc; ++c) {
-            const float dot = sa[c] + wa[c];
-            const float cross = sb[c] + wb[c];
-            const float d = ua + ub[c] - 2.0f * sy[c] - 2.0f * std::sqrt(dot * dot + cross * cross);
-            out[c] = std::max(d, 0.0f) * scale;
-        }
+        window_distances(cur, dc, RowWindow{f.window_spread[ui], f.window_cx[ui], f.window_cz[ui]}, f.weight, inv_wk,
+                         s.col_spread.data(), s.col_x.data(), s.col_z.data(), out);
         for (const std::int32_t c : s.invalid_cols) out[c] = kPairInvalid;
         // Same clip and windows starting at most k frames apart: g ∈ [i − k, i + k].
         const std::int32_t c_lo = std::max(i - k - col0, 0), c_hi = std::min(i + k - col0, dc - 1);
@@ -386,17 +476,31 @@ void run_tile(const FrameFeatures& f, const CandidateSearchOptions& o, std::int3
         if (i < ei0 || i >= ei1 || j < ej0 || j >= ej1) return kPairInvalid;  // outside the valid range
         return s.d[static_cast<size_t>(i - ei0) * static_cast<size_t>(dc) + static_cast<size_t>(j - ej0)];
     };
-    for (std::int32_t i = ci0; i < ci1; ++i)
-        for (std::int32_t j = cj0; j < cj1; ++j) {
-            const float v = at(i, j);
-            if (v >= 0.0f && v < kPairInvalid) ++s.evaluations;
-            if (o.plot && v >= 0.0f && v < kPairInvalid) {
+    const double keep_below = std::max(o.threshold, o.bridge_threshold);
+    for (std::int32_t i = ci0; i < ci1; ++i) {
+        const float* __restrict row = s.d.data() + static_cast<size_t>(i - ei0) * udc;  // row[j − ej0]
+        std::int64_t evaluated = 0;  // (a separate branch-free loop: it vectorises)
+        for (std::int32_t c = cj0 - ej0; c < cj1 - ej0; ++c) evaluated += row[c] >= 0.0f && row[c] < kPairInvalid;
+        s.evaluations += evaluated;
+        if (o.plot)
+            for (std::int32_t j = cj0; j < cj1; ++j) {
+                const float v = row[j - ej0];
+                if (!(v >= 0.0f && v < kPairInvalid)) continue;
                 const size_t px = static_cast<size_t>(static_cast<std::int64_t>(i) * o.plot_size / N);
                 const size_t py = static_cast<size_t>(static_cast<std::int64_t>(j) * o.plot_size / N);
                 float& pixel = s.plot[px * static_cast<size_t>(o.plot_size) + py];
                 pixel = std::min(pixel, v);
             }
-            if (!is_local_minimum(v, i, j, h, std::max(o.threshold, o.bridge_threshold), at)) continue;
+        for (std::int32_t j = cj0; j < cj1; ++j) {
+            const float v = row[j - ej0];
+            if (!(v >= 0.0f) || static_cast<double>(v) > keep_below) continue;  // (also the absent pairs)
+            // Most cells below the threshold lie on a valley's slope: a smaller (or
+            // excluded) direct neighbour rejects them before the full neighbourhood.
+            const float n0 = at(i, j - 1), n1 = at(i, j + 1), n2 = at(i - 1, j), n3 = at(i + 1, j);
+            if (n0 < v || n1 < v || n2 < v || n3 < v) continue;
+            const float n4 = at(i - 1, j - 1), n5 = at(i + 1, j + 1), n6 = at(i - 1, j + 1), n7 = at(i + 1, j - 1);
+            if (n4 < v || n5 < v || n6 < v || n7 < v) continue;
+            if (!is_local_minimum(v, i, j, h, keep_below, at)) continue;
             if (v <= o.threshold) {
                 s.found.push_back({i, j, v});
                 continue;
@@ -407,6 +511,7 @@ void run_tile(const FrameFeatures& f, const CandidateSearchOptions& o, std::int3
                       [](const TransitionCandidate& a, const TransitionCandidate& b) { return a.distance < b.distance; });
             if (best.size() > static_cast<size_t>(o.bridges_per_clip_pair)) best.pop_back();
         }
+    }
     for (const auto& [clips, best] : bridges) s.found.insert(s.found.end(), best.begin(), best.end());
 }
 
@@ -419,6 +524,13 @@ CandidateSearchResult find_transition_candidates(const FrameFeatures& f, const C
     const std::int64_t tile_count = static_cast<std::int64_t>(tiles_per_side) * tiles_per_side;
     const int threads = static_cast<int>(std::min<std::int64_t>(thread_count(o.threads), std::max<std::int64_t>(tile_count, 1)));
     std::vector<TileScratch> scratch(static_cast<size_t>(threads));
+    {  // the largest tile plus halo, once: no reallocation as tile sizes vary
+        const size_t side = static_cast<size_t>(std::min(T + 2 * o.neighbourhood + f.window - 1, std::max(f.frames, 1)));
+        for (TileScratch& s : scratch) {
+            s.ca.ensure(side * side), s.cb.ensure(side * side), s.cy.ensure(side * side);
+            s.d.ensure(side * side);
+        }
+    }
     if (o.plot)
         for (TileScratch& s : scratch)
             s.plot.assign(static_cast<size_t>(o.plot_size) * static_cast<size_t>(o.plot_size), kPairInvalid);
@@ -464,7 +576,8 @@ CandidateSearchResult find_transition_candidates_reference(const ClipDatabase& d
         for (std::int32_t j = 0; j < N; ++j) {
             float v = pair_status(f, i, j);
             if (v == 0.0f) {
-                v = static_cast<float>(reference_pair_distance(db, positions, f.window, scale, i, j));
+                const double r = reference_pair_distance(db, positions, f.window, scale, i, j);
+                v = static_cast<float>(r > kDistanceNoiseFloor ? r : 0.0);
                 ++out.pair_evaluations;
             }
             d[static_cast<size_t>(i) * static_cast<size_t>(N) + static_cast<size_t>(j)] = v;

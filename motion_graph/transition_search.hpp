@@ -2,8 +2,8 @@
 // Finding transition candidates: Kovar's point-cloud distance between every pair
 // of k-frame windows of the database, computed tile by tile so the N×N matrix is
 // never held. Per tile, the cross terms of all frame pairs are three sgemm products
-// of per-frame feature rows; the k-frame window then becomes a difference of prefix
-// sums along the tile's diagonals, and the closed-form 2D alignment turns the sums
+// (dgemm) of per-frame feature rows; the k-frame window then becomes a sum sliding
+// along the tile's diagonals, and the closed-form 2D alignment turns the sums
 // into the minimal distance. Tiles carry a halo of the local-minimum
 // neighbourhood, so each tile decides its own local minima.
 #include <cstdint>
@@ -27,15 +27,15 @@ struct FrameFeatures {
     std::int32_t joints = 0;
     std::int32_t window = 10;            // k
     double weight = 0.0;                 // Σ w_j
-    std::vector<float> xz;               // [f][2J]: √w(x − cx)…, √w(z − cz)… (c: frame centroid)
-    std::vector<float> zx;               // [f][2J]: √w(z − cz)…, −√w(x − cx)…
-    std::vector<float> y;                // [f][J]:  √w·y
+    // Double, not float: the distance is a difference of sums ~1000× larger than
+    // itself near the minima, where float products (sgemm) err by more than
+    // neighbouring cells differ, and the candidates would follow the rounding.
+    std::vector<double> xz;              // [f][2J]: √w(x − cx)…, √w(z − cz)… (c: frame centroid)
+    std::vector<double> zx;              // [f][2J]: √w(z − cz)…, −√w(x − cx)…
+    std::vector<double> y;               // [f][J]:  √w·y
     std::vector<double> cx, cz;          // weighted ground-plane centroid per frame
     std::vector<double> window_spread;   // per window start: Σ w|p − centroid|² over the window
     std::vector<double> window_cx, window_cz;  // per window start: Σ_t c over the window
-    // Per window start, 2k floats: √W·(c_t − window mean) as x…, z… (and z…, −x…),
-    // whose products give the centroid part of the alignment sums.
-    std::vector<float> window_dot, window_cross;
     std::vector<std::int32_t> clip_of;   // clip index of every frame
     std::vector<std::uint8_t> start_ok;  // the window starting here stays in one clip
     std::vector<std::uint8_t> end_ok;    // the window ending here stays in one clip
@@ -48,6 +48,12 @@ FrameFeatures compute_frame_features(const ClipDatabase& db, std::span<const vec
 // start fewer than k+1 frames apart (the trivial near-diagonal, which no local
 // minimum may touch).
 inline constexpr float kPairInvalid = 3.0e38f;
+// Distances at or below this (normalised: an RMS point distance of 3e-5 leg lengths)
+// count as 0 in both searches. Repeats of periodic motion give windows that match to
+// the arithmetic's noise (1e-18 … 1e-12, a difference of sums ~1 in double), and
+// which of those a local minimum picks would follow the rounding; at 0 the raster
+// order decides, the same in both.
+inline constexpr double kDistanceNoiseFloor = 1e-9;
 inline constexpr float kPairExcluded = -1.0f;
 
 // The same quantity for one pair, straight from the features in double (the

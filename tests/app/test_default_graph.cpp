@@ -8,7 +8,9 @@
 #include <memory>
 
 #include "app/default_graph.hpp"
+#include "app/embedded.hpp"
 #include "app/graph_files.hpp"
+#include "motion_graph/transition_search.hpp"
 #include "motion_graph/clip_database.hpp"
 #include "runtime/graph_path.hpp"
 #include "runtime/puppet.hpp"
@@ -244,4 +246,32 @@ TEST_CASE("default graph: every face button plays its action while walking and s
             // Deterministic: a second run gives the same hash every tick.
             if (button == 0) CHECK(run_action(graph, button, label, stick_y).hashes == run.hashes);
         }
+}
+
+TEST_CASE("default graph: the tiled search finds exactly the reference's candidates", "[default_graph][distance]") {
+    // The locomotion clips are procedural and periodic, so their distance valleys
+    // are flat to ~1e-8 along the diagonal: a search that rounds more than the
+    // reference would pick other minima there (the float sgemm path did); below
+    // kDistanceNoiseFloor both count as 0.
+    const graph::GraphBuildParams params = graph_build_params(SimConfig{});
+    std::vector<Clip> clips = generate_locomotion_clips(SimConfig{}, params.analysis_rate_hz);
+    for (Clip& c : default_action_clips()) clips.push_back(std::move(c));
+    const graph::LabelRules rules =
+        graph::parse_label_rules(std::string(embedded::find("config/graph_labels.toml")), "config/graph_labels.toml");
+    const graph::ClipDatabase db = graph::make_clip_database(std::move(clips), {}, rules, params.analysis_rate_hz);
+    const double leg = graph::skeleton_leg_length(db.skeleton, db.left_foot >= 0 ? db.left_foot : db.right_foot);
+    const std::vector<vec3> p = graph::database_positions(db);
+    const graph::FrameFeatures f = graph::compute_frame_features(db, p, params.window_frames, leg);
+    graph::CandidateSearchOptions o;
+    o.neighbourhood = params.neighbourhood_frames;
+    o.threshold = default_build().output.threshold;
+    const graph::CandidateSearchResult tiled = graph::find_transition_candidates(f, o);
+    const graph::CandidateSearchResult reference = graph::find_transition_candidates_reference(db, p, f, leg, o);
+    CHECK(tiled.pair_evaluations == reference.pair_evaluations);
+    REQUIRE(tiled.candidates.size() == reference.candidates.size());
+    CHECK(tiled.candidates.size() > 100);
+    for (size_t c = 0; c < tiled.candidates.size(); ++c) {
+        CHECK(tiled.candidates[c].from_frame == reference.candidates[c].from_frame);
+        CHECK(tiled.candidates[c].to_frame == reference.candidates[c].to_frame);
+    }
 }

@@ -88,3 +88,103 @@ TEST_CASE("a log whose clip data differ from this build is refused", "[golden]")
     log.header.clip_data_hash ^= 1;
     CHECK_THROWS_WITH(replay_log(log, "x.mlog", {}), Catch::Contains("different clip data"));
 }
+
+// ---- golden traces with the motion graph ---------------------------------------
+// The embedded default graph drives these (graph, graph_feet on stairs, and a log
+// whose recorded configuration changes switch gait → graph_feet → gait live, so
+// the cross-fades are in the trace). The graph is built by the BLAS transition
+// search; should a machine's BLAS round differently and build other graph bytes
+// (tests/golden/default_graph.hash says which the traces were made with), the
+// traces cannot apply: the test then says so and checks only that record and
+// replay agree tick for tick. MARIONETTE_WRITE_GOLDEN=1 writes the traces and the
+// hash into the working directory (scripts/update-golden.sh copies them over).
+#include <cstdlib>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <xxhash.h>
+
+#include "app/default_graph.hpp"
+#include "app/graph_files.hpp"
+
+namespace {
+struct GraphGolden {
+    const char* name;
+    std::string program;                 // load_program spec
+    const char* source;                  // [motion] source of the recording
+    const char* terrain;
+    std::vector<std::pair<std::uint64_t, const char*>> switches;  // before tick → [motion] source
+};
+
+std::string source_config(const char* source) { return fmt::format("[motion]\nsource = \"{}\"\n", source); }
+}  // namespace
+
+TEST_CASE("replays driven by the default motion graph match the committed golden traces", "[golden][golden_graph]") {
+    const bool write = std::getenv("MARIONETTE_WRITE_GOLDEN") != nullptr;
+    SimConfig base = default_config();  // stairs, as shipped
+    const auto graph = std::make_shared<const MotionGraph>(build_default_motion_graph(base));
+    const std::vector<std::uint8_t> graph_bytes = serialize_motion_graph(*graph);
+    const std::string graph_hash = fmt::format("{:016x}", XXH64(graph_bytes.data(), graph_bytes.size(), 0));
+    const std::string hash_path = test::source_path("tests/golden/default_graph.hash");
+    std::string golden_hash;
+    if (std::ifstream in(hash_path); in) in >> golden_hash;
+    if (write) std::ofstream("default_graph.hash") << graph_hash << "\n";
+    const bool comparable = golden_hash == graph_hash;
+    if (!comparable && !write)
+        WARN("this build's default graph (" << graph_hash << ") is not the one the golden traces were made with ("
+                                            << golden_hash << "): only record against replay is checked");
+
+    const GraphGolden cases[] = {
+        {"graph_actions", test::source_path("config/programs/actions.prog"), "graph", "flat", {}},
+        {"graph_feet_circle_stairs", "builtin:circle", "graph_feet", "stairs", {}},
+        {"graph_switch_stairs", "builtin:demo", "gait", "stairs", {{480, "graph_feet"}, {1440, "gait"}}},
+    };
+    for (const GraphGolden& c : cases) {
+        INFO("golden " << c.name);
+        SimConfig config = config_from_text(source_config(c.source) + fmt::format("[terrain]\nname = \"{}\"\n", c.terrain), c.name);
+        // Record: the simulation as the live pipeline runs it, config changes at tick boundaries.
+        const StickProgram program = load_program(c.program);
+        const std::vector<TickInput> ticks = render_stick_program(program, config.tick_rate_hz);
+        Simulation sim(config);
+        attach_motion_graph(sim, graph);
+        InputLogHeader header;
+        header.tick_rate_hz = static_cast<std::uint32_t>(config.tick_rate_hz);
+        header.clip_data_hash = sim.clip_data_hash();
+        header.config_text = serialize_config(config);
+        DecodedInputLog log = decode_input_log(encode_input_log(header, ticks, 60), c.name);
+        std::vector<std::uint64_t> recorded;
+        size_t next_switch = 0;
+        SimConfig running = config;
+        for (std::uint64_t k = 0; k < ticks.size(); ++k) {
+            if (next_switch < c.switches.size() && c.switches[next_switch].first == k) {
+                const std::string text = source_config(c.switches[next_switch].second);
+                running = apply_config_text(running, text, c.name);
+                REQUIRE(sim.retune(running).empty());
+                log.config_changes.push_back({k, serialize_config(running)});
+                ++next_switch;
+            }
+            sim.step(ticks[k]);
+            recorded.push_back(hash_state(sim.state()));
+        }
+        const std::string trace_path = fmt::format("golden_{}.csv", c.name);
+        ReplayOptions options;
+        options.trace_csv = trace_path;
+        options.keep_tick_hashes = true;
+        options.graph = graph;
+        const ReplayResult result = replay_log(log, c.name, options);
+        REQUIRE(result.tick_hashes == recorded);  // the replay is the recording, tick for tick
+        CHECK(result.config_changes == static_cast<int>(c.switches.size()));
+        CHECK(result.distance_m > 1.0);
+        if (write || !comparable) continue;
+        const std::vector<std::string> actual = lines_of(test::read_text_file(trace_path));
+        const std::vector<std::string> golden =
+            lines_of(test::read_text_file(test::source_path(fmt::format("tests/golden/{}.trace.csv", c.name))));
+        REQUIRE(actual.size() == golden.size());
+        for (size_t i = 0; i < golden.size(); ++i) {
+            if (actual[i] != golden[i]) {
+                INFO("first difference at line " << i + 1 << "\n  golden: " << golden[i] << "\n  actual: " << actual[i]);
+                REQUIRE(actual[i] == golden[i]);
+            }
+        }
+    }
+}

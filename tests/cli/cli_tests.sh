@@ -70,7 +70,9 @@ if [[ -d $mocap/cmu_amc_16 ]]; then
   check "graph build keeps walk, run and turn clips" python3 -c "import json,sys; k=json.load(open('build.json'))['clips_kept']; sys.exit(0 if {'16_15','16_35','16_17','16_41'} <= set(k) else 1)"
   check "graph build writes a PNG plot" bash -c "head -c 8 m.png | od -An -c | grep -q 'P   N   G'"
   check "graph build writes a Graphviz graph" grep -q '^digraph motion_graph' g.dot
+  check "graph build is byte-identical run to run (no build time in the file)" bash -c "'$bin' graph build --asf '$mocap/cmu_amc_16/16.asf' '$mocap'/cmu_amc_16/*.amc -o cmu16b.mgraph >/dev/null && cmp cmu16.mgraph cmu16b.mgraph"
   "$bin" graph info cmu16.mgraph --json >info.json
+  check "graph info claims no build time (the file stores none)" python3 -c "import json,sys; sys.exit(0 if 'build_seconds' not in json.load(open('info.json')) else 1)"
   check "graph info reports the pruned graph" python3 -c "import json,sys; a=json.load(open('info.json')); b=json.load(open('build.json')); sys.exit(0 if a['nodes']==b['nodes'] and a['edges']==b['edges'] else 1)"
   check "graph path finds a walk → run path and writes its BVH" bash -c "'$bin' graph path cmu16.mgraph --from 16_15:40 --to 16_35:20 --json --bvh path.bvh >path.json"
   check "the path BVH imports" bash -c "'$bin' clip info path.bvh --json | grep -q '\"joints\":31'"

@@ -112,7 +112,7 @@ TEST_CASE("local minima on synthetic matrices", "[graph][minima]") {
     CHECK(local_minima(m, n, n, 2, 1e9).size() == 1);
 }
 
-TEST_CASE("the tiled sgemm search finds the same candidates as the reference", "[graph][distance]") {
+TEST_CASE("the tiled dgemm search finds the same candidates as the reference", "[graph][distance]") {
     // With capture-like noise: exactly periodic motion has valleys flat to 1e-7,
     // below float resolution, where any rounding picks a different minimum.
     const ClipDatabase db = synthetic_database(0.05);
@@ -133,6 +133,22 @@ TEST_CASE("the tiled sgemm search finds the same candidates as the reference", "
         CHECK(tiled.candidates[c].to_frame == reference.candidates[c].to_frame);
         CHECK(tiled.candidates[c].distance == Approx(reference.candidates[c].distance).epsilon(1e-3).margin(1e-6));
     }
+}
+
+TEST_CASE("two builds of the same clips serialize to identical bytes", "[graph][determinism]") {
+    // The file's bytes enter the simulation's clip-data hash: no wall-clock build
+    // time (or anything else run-dependent) may be stored in them.
+    const ClipDatabase db = synthetic_database(0.05);
+    GraphBuildParams params;
+    params.window_frames = 8;
+    params.threads = 2;
+    const GraphBuildOutput a = build_motion_graph(db, params);
+    const GraphBuildOutput b = build_motion_graph(db, params);
+    CHECK(a.graph.stats.build_seconds == 0.0);
+    CHECK(a.regular_candidates > 0);
+    const std::vector<std::uint8_t> bytes_a = serialize_motion_graph(a.graph), bytes_b = serialize_motion_graph(b.graph);
+    CHECK(bytes_a.size() > 1000);
+    CHECK(bytes_a == bytes_b);
 }
 
 TEST_CASE("clips with different skeletons are refused naming the first mismatch", "[graph][database]") {
