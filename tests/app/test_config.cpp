@@ -2,24 +2,10 @@
 
 #include "app/config.hpp"
 #include "app/terrain_file.hpp"
+#include "tests/config_error_check.hpp"
 #include "tests/test_support.hpp"
 
 using namespace marionette;
-
-namespace {
-void expect_error(const std::string& text, int line, const std::string& key, const std::string& message) {
-    INFO(text);
-    try {
-        apply_config_text(default_config(), text, "user.toml");
-        FAIL("no error");
-    } catch (const ConfigError& e) {
-        CHECK(e.file() == "user.toml");
-        CHECK(e.line() == line);
-        CHECK(e.key() == key);
-        CHECK_THAT(e.what(), Catch::Contains(message));
-    }
-}
-}  // namespace
 
 TEST_CASE("the shipped default file gives the built-in defaults", "[config]") {
     const SimConfig loaded = default_config();
@@ -42,17 +28,17 @@ TEST_CASE("a user file overrides only what it names", "[config]") {
 }
 
 TEST_CASE("bad configuration names file, line, key and what was expected", "[config]") {
-    expect_error("[locomotion]\nmax_sped = 2.0\n", 2, "locomotion.max_sped", "unknown key");
-    expect_error("[locomotoin]\nmax_speed = 2.0\n", 1, "locomotoin", "unknown table");
-    expect_error("\n[simulation]\ntick_rate_hz = \"fast\"\n", 3, "simulation.tick_rate_hz", "expected an integer in [30.0, 2000.0]");
-    expect_error("[simulation]\ntick_rate_hz = 240.5\n", 2, "simulation.tick_rate_hz", "expected an integer");
-    expect_error("[simulation]\ntick_rate_hz = 5\n", 2, "simulation.tick_rate_hz", "5 is out of range");
-    expect_error("[locomotion]\nstick_deadzone = 0.95\n", 2, "locomotion.stick_deadzone", "out of range");
-    expect_error("[locomotion]\nmax_speed = nan\n", 2, "locomotion.max_speed", "out of range");
-    expect_error("[locomotion]\nmax_speed = true\n", 2, "locomotion.max_speed", "expected a number");
-    expect_error("[locomotion\nmax_speed = 1\n", 1, "", "TOML syntax error");
-    expect_error("max_speed = 1\n", 1, "max_speed", "unknown table");
-    expect_error("[puppet]\npelvis_height = 1.2\n", 2, "puppet.pelvis_height", "feet cannot reach");
+    test::expect_config_error("[locomotion]\nmax_sped = 2.0\n", 2, "locomotion.max_sped", "unknown key");
+    test::expect_config_error("[locomotoin]\nmax_speed = 2.0\n", 1, "locomotoin", "unknown table");
+    test::expect_config_error("\n[simulation]\ntick_rate_hz = \"fast\"\n", 3, "simulation.tick_rate_hz", "expected an integer in [30.0, 2000.0]");
+    test::expect_config_error("[simulation]\ntick_rate_hz = 240.5\n", 2, "simulation.tick_rate_hz", "expected an integer");
+    test::expect_config_error("[simulation]\ntick_rate_hz = 5\n", 2, "simulation.tick_rate_hz", "5 is out of range");
+    test::expect_config_error("[locomotion]\nstick_deadzone = 0.95\n", 2, "locomotion.stick_deadzone", "out of range");
+    test::expect_config_error("[locomotion]\nmax_speed = nan\n", 2, "locomotion.max_speed", "out of range");
+    test::expect_config_error("[locomotion]\nmax_speed = true\n", 2, "locomotion.max_speed", "expected a number");
+    test::expect_config_error("[locomotion\nmax_speed = 1\n", 1, "", "TOML syntax error");
+    test::expect_config_error("max_speed = 1\n", 1, "max_speed", "unknown table");
+    test::expect_config_error("[puppet]\npelvis_height = 1.2\n", 2, "puppet.pelvis_height", "feet cannot reach");
 }
 
 TEST_CASE("a missing user file is a clear error", "[config]") {

@@ -7,24 +7,12 @@
 #include "app/config.hpp"
 #include "app/graph_files.hpp"
 #include "tests/graph_fixture.hpp"
+#include "tests/config_error_check.hpp"
 
 using namespace marionette;
 
 namespace {
 std::size_t bit(Button b) { return static_cast<std::size_t>(b); }
-
-void expect_config_error(const std::string& text, int line, const std::string& key, const std::string& message) {
-    INFO(text);
-    try {
-        apply_config_text(default_config(), text, "user.toml");
-        FAIL("no error");
-    } catch (const ConfigError& e) {
-        CHECK(e.file() == "user.toml");
-        CHECK(e.line() == line);
-        CHECK(e.key() == key);
-        CHECK_THAT(e.what(), Catch::Contains(message));
-    }
-}
 }  // namespace
 
 TEST_CASE("graph buttons: the shipped file maps the face buttons to the default graph's actions", "[graph_buttons]") {
@@ -51,10 +39,10 @@ TEST_CASE("graph buttons: a user file remaps buttons and the map round-trips", "
 }
 
 TEST_CASE("graph buttons: bad keys and values name file, line and key", "[graph_buttons]") {
-    expect_config_error("[motion_graph.buttons]\nsouth_button = \"jump\"\n", 2, "motion_graph.buttons.south_button", "unknown button");
-    expect_config_error("[motion_graph.buttons]\n\nnorth = 3\n", 3, "motion_graph.buttons.north", "expected a label name");
-    expect_config_error("[motion_graph]\nbuttons = 1\n", 2, "motion_graph.buttons", "expected a table");
-    expect_config_error("[motion_graph.buttons]\nwest = \"a\\tb\"\n", 2, "motion_graph.buttons.west", "control characters");
+    test::expect_config_error("[motion_graph.buttons]\nsouth_button = \"jump\"\n", 2, "motion_graph.buttons.south_button", "unknown button");
+    test::expect_config_error("[motion_graph.buttons]\n\nnorth = 3\n", 3, "motion_graph.buttons.north", "expected a label name");
+    test::expect_config_error("[motion_graph]\nbuttons = 1\n", 2, "motion_graph.buttons", "expected a table");
+    test::expect_config_error("[motion_graph.buttons]\nwest = \"a\\tb\"\n", 2, "motion_graph.buttons.west", "control characters");
 }
 
 TEST_CASE("graph buttons: resolved against the graph's labels", "[graph_buttons]") {
