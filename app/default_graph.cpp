@@ -44,6 +44,13 @@ const LocomotionProgram kLocomotion[] = {
     // Start from standing and stop again: the idle ↔ walk/run links.
     {"idle_walk_stop", "hold 1s\nramp 500ms ly=-0.5\nhold 2.5s\nramp 300ms ly=0\nhold 2.5s\n", 0.0},
     {"idle_run_stop", "hold 1s\nramp 500ms ly=-1\nhold 2.5s\nramp 300ms ly=0\nhold 2.5s\n", 0.0},
+    // Turns on the spot: from standing toward the puppet's back, left and right,
+    // and a reversal while walking (the gait turns in place past turn_in_place_deg),
+    // so the graph can head anywhere, not only where its clips happen to face.
+    {"idle_turn_back_walk", "hold 1s\nramp 300ms ly=0.5\nhold 3s\nramp 300ms ly=0\nhold 1.5s\n", 0.0},
+    {"idle_turn_left_walk", "hold 1s\nramp 300ms lx=0.5\nhold 3s\nramp 300ms lx=0\nhold 1.5s\n", 0.0},
+    {"idle_turn_right_walk", "hold 1s\nramp 300ms lx=-0.5\nhold 3s\nramp 300ms lx=0\nhold 1.5s\n", 0.0},
+    {"walk_turn_back", "ramp 500ms ly=-0.5\nhold 2s\nramp 200ms ly=0.5\nhold 3s\n", 1.0},
 };
 
 const char* const kActionPaths[] = {"config/clips/wave.bvh", "config/clips/bow.bvh", "config/clips/jump.bvh",
