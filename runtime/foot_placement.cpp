@@ -117,6 +117,11 @@ void FootPlacementJob::run() const {
         if (pin.contact == 1) pin.release = 0.0f;
         else pin.release = release_s > 0.0f ? clamp01(pin.release + dt / release_s) : 1.0f;
         if (!s.started) pin.release = pin.contact == 1 ? 0.0f : 1.0f;
+        // The tilt to the ground eases in and out over release_s as well: a foot
+        // landing on a slope must not snap to it.
+        const float plant_step = release_s > 0.0f ? dt / release_s : 1.0f;
+        pin.plant = !s.started ? (pin.contact == 1 ? 1.0f : 0.0f)
+                               : clamp01(pin.plant + (pin.contact == 1 ? plant_step : -plant_step));
         const vec3 target = lerp(pin.pin, free, smoothstep(pin.release));
 
         const vec3 h = model_positions[hip], k = model_positions[knee], a = model_positions[ankle];
@@ -136,7 +141,10 @@ void FootPlacementJob::run() const {
         const quat hip_world = quat_normalize(quat_mul(turn_upper, model_rotations[hip]));
         const quat knee_world = quat_normalize(quat_mul(turn_lower, quat_mul(turn_upper, model_rotations[knee])));
         // A planted foot lies on the ground's slope; a lifted one keeps the clip's.
-        const quat tilt = quat_slerp(quat_identity(), quat_from_to(up, sample[i].normal), 1.0f - smoothstep(pin.release));
+        // (The normal under the target, not under the clip's foot: a pinned foot
+        // must not tilt because the clip's foot slid over a slope's edge.)
+        const vec3 normal = query_ground(*terrain, target.x, target.z).normal;
+        const quat tilt = quat_slerp(quat_identity(), quat_from_to(up, normal), smoothstep(pin.plant));
         const quat foot_world = quat_normalize(quat_mul(tilt, model_rotations[ankle]));
         const int hip_parent = parents[hip];
         const quat parent_world = hip_parent >= 0 ? model_rotations[static_cast<size_t>(hip_parent)] : quat_identity();

@@ -31,6 +31,7 @@ struct FootPin {
     vec3 clip_previous{0.0f};    // the clip's ankle last tick (world, before placement): its speed
     float ground = 0.0f;         // ground height the foot is placed on, eased toward the ground ahead of it
     float release = 1.0f;        // 0 held at the pin … 1 following the clip's foot
+    float plant = 0.0f;          // 0 the clip's foot rotation … 1 tilted to the ground: eased both ways
     std::int32_t contact = 0;    // 0 free, 1 pinned, 2 in contact but let go (the pin slipped too far from the clip)
 };
 

@@ -424,7 +424,9 @@ std::uint64_t hash_state(const PuppetState& s) {
         for (const FootPin& f : s.feet.feet) {
             hash_vec(h, f.pin);
             hash_vec(h, f.placed);
-            hash_floats(h, &f.release, 1);
+            hash_vec(h, f.clip_previous);
+            const float weights[3] = {f.ground, f.release, f.plant};
+            hash_floats(h, weights, 3);
         }
     }
     const int n = s.joint_count < 0 ? 0 : (s.joint_count > kMaxJoints ? kMaxJoints : s.joint_count);
