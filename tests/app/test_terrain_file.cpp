@@ -4,21 +4,14 @@
 
 #include "app/config.hpp"
 #include "app/terrain_file.hpp"
+#include "tests/config_error_check.hpp"
 
 using namespace marionette;
 
 namespace {
 void expect_error(const std::string& text, int line, const std::string& key, const std::string& message) {
-    INFO(text);
-    try {
-        parse_terrain_text(text, "ground.toml");
-        FAIL("no error");
-    } catch (const ConfigError& e) {
-        CHECK(e.file() == "ground.toml");
-        CHECK(e.line() == line);
-        CHECK(e.key() == key);
-        CHECK_THAT(e.what(), Catch::Contains(message));
-    }
+    test::expect_config_error_from([](const std::string& t, const std::string& f) { parse_terrain_text(t, f); },
+                                   "ground.toml", text, line, key, message);
 }
 }  // namespace
 
