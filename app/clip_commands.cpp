@@ -8,8 +8,8 @@
 #include "app/commands.hpp"
 #include "app/files.hpp"
 #include "app/json.hpp"
-#include "runtime/asf_amc.hpp"
-#include "runtime/bvh.hpp"
+#include "runtime/formats/asf_amc.hpp"
+#include "runtime/formats/bvh.hpp"
 
 namespace marionette {
 

@@ -163,7 +163,7 @@ void apply_terrain_table(SimConfig& config, const toml::table& table, const std:
 }
 
 // [gait.walk] / [gait.run]: swing_foot, pelvis, hand, each an array of
-// [phase, x, y, z] keys (runtime/gait_prototype.hpp says what x, y, z mean).
+// [phase, x, y, z] keys (runtime/gait/gait_prototype.hpp says what x, y, z mean).
 void apply_prototype_table(GaitPrototypes& out, const toml::node& node, const std::string& table, const std::string& file) {
     const toml::table* t = node.as_table();
     if (!t) throw ConfigError(file, line_of(node), table, "expected a table ([" + table + "]) of swing_foot, pelvis, hand");

@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include "runtime/sim_config.hpp"
+#include "runtime/sim/sim_config.hpp"
 
 namespace marionette {
 

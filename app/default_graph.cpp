@@ -9,10 +9,10 @@
 
 #include "app/embedded.hpp"
 #include "app/graph_files.hpp"
-#include "motion_graph/clip_database.hpp"
-#include "runtime/bvh.hpp"
-#include "runtime/simulation.hpp"
-#include "runtime/stick_program.hpp"
+#include "graph_builder/clip_database.hpp"
+#include "runtime/formats/bvh.hpp"
+#include "runtime/sim/simulation.hpp"
+#include "runtime/formats/stick_program.hpp"
 
 namespace marionette {
 
@@ -26,7 +26,7 @@ struct LocomotionProgram {
     double keep_from_s;
 };
 
-// Stick conventions (runtime/stick_program.hpp): ly up walks toward −Z, but the
+// Stick conventions (runtime/formats/stick_program.hpp): ly up walks toward −Z, but the
 // puppet starts facing +Z, so the programs push the stick down (ly < 0): every clip
 // then walks the way it faces from the start, and no start turns on the spot. A
 // circle with positive turns sweeps the stick counter-clockwise (down → right here:
@@ -122,20 +122,20 @@ std::vector<Clip> generate_locomotion_clips(const SimConfig& config, double rate
     return clips;
 }
 
-DefaultGraphBuild build_default_motion_graph_report(const SimConfig& config, const graph::GraphBuildHooks& hooks) {
+DefaultGraphBuild build_default_motion_graph_report(const SimConfig& config, const offline::GraphBuildHooks& hooks) {
     const auto started = std::chrono::steady_clock::now();
-    const graph::GraphBuildParams params = graph_build_params(config);
+    const offline::GraphBuildParams params = graph_build_params(config);
     std::vector<Clip> clips = generate_locomotion_clips(config, params.analysis_rate_hz);
     for (Clip& c : default_action_clips()) clips.push_back(std::move(c));
     std::vector<std::string> names;
     for (const Clip& c : clips) names.push_back(c.name);
-    const graph::LabelRules rules =
-        graph::parse_label_rules(std::string(embedded::find("config/graph_labels.toml")), "config/graph_labels.toml");
-    const graph::ClipDatabase db = graph::make_clip_database(std::move(clips), names, rules, params.analysis_rate_hz);
+    const offline::LabelRules rules =
+        offline::parse_label_rules(std::string(embedded::find("config/graph_labels.toml")), "config/graph_labels.toml");
+    const offline::ClipDatabase db = offline::make_clip_database(std::move(clips), names, rules, params.analysis_rate_hz);
 
     DefaultGraphBuild build;
     build.clips = static_cast<int>(db.clips.size());
-    build.output = graph::build_motion_graph(db, params, hooks);
+    build.output = offline::build_motion_graph(db, params, hooks);
     MotionGraph& g = build.output.graph;
     g.stats.build_seconds = 0.0;  // wall time would make the bytes differ run to run
     if (g.nodes.empty())

@@ -1,16 +1,16 @@
 #pragma once
 // The embedded default motion graph: the project's own action clips
 // (config/clips/*.bvh, compiled into the binary) plus locomotion captured from
-// the procedural gait over fixed stick programs, built with the motion_graph/
+// the procedural gait over fixed stick programs, built with the graph_builder/
 // builder and pruned so that every label survives. Needs no files at run time
 // and gives identical bytes on every run (docs/motion-graph.md, "The default graph").
 #include <string>
 #include <vector>
 
-#include "motion_graph/graph_builder.hpp"
-#include "runtime/clip.hpp"
-#include "runtime/motion_graph.hpp"
-#include "runtime/sim_config.hpp"
+#include "graph_builder/graph_builder.hpp"
+#include "runtime/anim/clip.hpp"
+#include "runtime/graph/motion_graph.hpp"
+#include "runtime/sim/sim_config.hpp"
 
 namespace marionette {
 
@@ -19,7 +19,7 @@ const std::vector<std::string>& default_action_clip_names();  // wave, bow, jump
 // The labels the default graph must keep (fails when one is cut off).
 const std::vector<std::string>& default_graph_labels();
 
-// The embedded action clips, imported with runtime/bvh.hpp (throws ImportError
+// The embedded action clips, imported with runtime/formats/bvh.hpp (throws ImportError
 // naming the embedded path if one is malformed or missing).
 std::vector<Clip> default_action_clips();
 
@@ -29,7 +29,7 @@ std::vector<Clip> default_action_clips();
 std::vector<Clip> generate_locomotion_clips(const SimConfig& config, double rate_hz);
 
 struct DefaultGraphBuild {
-    graph::GraphBuildOutput output;  // output.graph is the pruned default graph
+    offline::GraphBuildOutput output;  // output.graph is the pruned default graph
     int clips = 0;
     double build_ms = 0.0;           // wall time; not stored in the graph
 };
@@ -38,8 +38,8 @@ struct DefaultGraphBuild {
 // config's [motion_graph] parameters → pruned graph. The graph's build_seconds
 // stays 0 so its serialized bytes depend only on the inputs. Throws
 // std::runtime_error naming the label and why when a required label is cut off.
-// `hooks` as for graph::build_motion_graph (progress, plot size).
-DefaultGraphBuild build_default_motion_graph_report(const SimConfig& config, const graph::GraphBuildHooks& hooks = {});
+// `hooks` as for offline::build_motion_graph (progress, plot size).
+DefaultGraphBuild build_default_motion_graph_report(const SimConfig& config, const offline::GraphBuildHooks& hooks = {});
 MotionGraph build_default_motion_graph(const SimConfig& config);
 
 }  // namespace marionette

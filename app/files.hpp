@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "runtime/input_log.hpp"
+#include "runtime/formats/input_log.hpp"
 
 namespace marionette {
 

@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "app/graph_files.hpp"
-#include "runtime/gait.hpp"
-#include "runtime/puppet.hpp"
-#include "runtime/simulation.hpp"
+#include "runtime/gait/gait.hpp"
+#include "runtime/gait/puppet.hpp"
+#include "runtime/sim/simulation.hpp"
 
 namespace marionette {
 

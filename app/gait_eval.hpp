@@ -6,9 +6,9 @@
 #include <memory>
 #include <string>
 
-#include "runtime/motion_graph.hpp"
-#include "runtime/sim_config.hpp"
-#include "runtime/stick_program.hpp"
+#include "runtime/graph/motion_graph.hpp"
+#include "runtime/sim/sim_config.hpp"
+#include "runtime/formats/stick_program.hpp"
 
 namespace marionette {
 

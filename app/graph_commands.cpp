@@ -19,10 +19,10 @@
 #include "app/graph_files.hpp"
 #include "app/graph_rebuild.hpp"
 #include "app/json.hpp"
-#include "motion_graph/graph_builder.hpp"
+#include "graph_builder/graph_builder.hpp"
 #include "render_es/image.hpp"
-#include "runtime/bvh.hpp"
-#include "runtime/graph_path.hpp"
+#include "runtime/formats/bvh.hpp"
+#include "runtime/graph/graph_path.hpp"
 
 namespace marionette {
 
@@ -73,7 +73,7 @@ std::string label_names(const MotionGraph& g, std::uint32_t mask) {
     return "[" + out + "]";
 }
 
-void write_plot(const std::string& path, const graph::GraphBuildOutput& out) {
+void write_plot(const std::string& path, const offline::GraphBuildOutput& out) {
     const int size = out.plot_size;
     const std::int64_t n = out.frames;
     std::vector<unsigned char> rgb(static_cast<size_t>(size) * static_cast<size_t>(size) * 3, 0);  // RGB, then RGBA
@@ -83,7 +83,7 @@ void write_plot(const std::string& path, const graph::GraphBuildOutput& out) {
         for (int y = 0; y < size; ++y) {
             const float d = out.plot[static_cast<size_t>(x) * static_cast<size_t>(size) + static_cast<size_t>(y)];
             unsigned char v = 0;
-            if (d >= 0.0f && d < graph::kPairInvalid) v = static_cast<unsigned char>(255.0 * std::exp(-d / scale));
+            if (d >= 0.0f && d < offline::kPairInvalid) v = static_cast<unsigned char>(255.0 * std::exp(-d / scale));
             unsigned char* px = &rgb[(static_cast<size_t>(x) * static_cast<size_t>(size) + static_cast<size_t>(y)) * 3];
             px[0] = px[1] = px[2] = v;
         }
@@ -97,7 +97,7 @@ void write_plot(const std::string& path, const graph::GraphBuildOutput& out) {
             kept.insert({g.clips[static_cast<size_t>(a.clip)].first_frame + a.frame,
                          g.clips[static_cast<size_t>(b.clip)].first_frame + b.frame - 1});
         }
-    for (const graph::TransitionCandidate& c : out.candidates) {
+    for (const offline::TransitionCandidate& c : out.candidates) {
         const bool is_kept = kept.count({c.from_frame, c.to_frame}) > 0;
         const int x = static_cast<int>(c.from_frame * size / n), y = static_cast<int>(c.to_frame * size / n);
         for (int dx = -1; dx <= 1; ++dx)
@@ -182,10 +182,10 @@ int graph_default_build_command(const GraphBuildCommandOptions& o) {
     if (!o.clip_files.empty() || !o.asf_file.empty() || !o.labels_file.empty())
         throw ImportError("command line", 0, "--default builds the embedded clips: give no CLIPS, --asf or --labels with it");
     const SimConfig config = load_config(o.config_file);
-    graph::GraphBuildHooks hooks;
+    offline::GraphBuildHooks hooks;
     if (!o.plot_file.empty()) hooks.plot_size = 1024;
     const DefaultGraphBuild build = build_default_motion_graph_report(config, hooks);
-    const graph::GraphBuildOutput& out = build.output;
+    const offline::GraphBuildOutput& out = build.output;
     const MotionGraph& g = out.graph;
     write_binary_file(o.output_file, serialize_motion_graph(g));
     if (!o.plot_file.empty()) write_plot(o.plot_file, out);
@@ -222,12 +222,12 @@ int graph_build_command(const GraphBuildCommandOptions& o) {
         throw ImportError("command line", 0, "graph build needs CLIPS (.bvh, or .amc with --asf), or --default");
     const SimConfig config = load_config(o.config_file);
     const GraphSources sources{o.asf_file, o.clip_files, o.labels_file};
-    graph::GraphBuildParams params = graph_build_params(config);
+    offline::GraphBuildParams params = graph_build_params(config);
     params.threads = o.threads;
     const auto started = std::chrono::steady_clock::now();
-    const graph::ClipDatabase db = load_graph_sources(sources, params.analysis_rate_hz);
+    const offline::ClipDatabase db = load_graph_sources(sources, params.analysis_rate_hz);
 
-    graph::GraphBuildHooks hooks;
+    offline::GraphBuildHooks hooks;
     const bool bar = isatty(fileno(stderr)) != 0;
     if (bar)
         hooks.progress = [](double f) {
@@ -238,7 +238,7 @@ int graph_build_command(const GraphBuildCommandOptions& o) {
             std::fflush(stderr);
         };
     if (!o.plot_file.empty()) hooks.plot_size = 1024;
-    graph::GraphBuildOutput out = build_graph_from_sources(db, sources, params, hooks);
+    offline::GraphBuildOutput out = build_graph_from_sources(db, sources, params, hooks);
     MotionGraph& g = out.graph;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     if (g.nodes.empty())

@@ -27,8 +27,8 @@ void write_binary_file(const std::string& path, const std::vector<std::uint8_t>&
     if (!out) throw std::runtime_error(path + ": write failed: " + std::strerror(errno));
 }
 
-graph::GraphBuildParams graph_build_params(const SimConfig& c) {
-    graph::GraphBuildParams p;
+offline::GraphBuildParams graph_build_params(const SimConfig& c) {
+    offline::GraphBuildParams p;
     p.analysis_rate_hz = c.graph_analysis_rate_hz;
     p.window_frames = c.graph_window_frames;
     p.neighbourhood_frames = c.graph_neighbourhood_frames;

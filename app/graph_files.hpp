@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "motion_graph/graph_builder.hpp"
-#include "runtime/motion_graph.hpp"
-#include "runtime/sim_config.hpp"
-#include "runtime/simulation.hpp"
+#include "graph_builder/graph_builder.hpp"
+#include "runtime/graph/motion_graph.hpp"
+#include "runtime/sim/sim_config.hpp"
+#include "runtime/sim/simulation.hpp"
 
 namespace marionette {
 
@@ -22,7 +22,7 @@ MotionGraph load_motion_graph_file(const std::string& path);
 // source is graph or graph_feet, and no graph (nullptr) otherwise.
 std::shared_ptr<const MotionGraph> load_graph_argument(const std::string& argument, const SimConfig& config);
 void write_binary_file(const std::string& path, const std::vector<std::uint8_t>& bytes);
-graph::GraphBuildParams graph_build_params(const SimConfig& config);
+offline::GraphBuildParams graph_build_params(const SimConfig& config);
 
 // [motion_graph.buttons] resolved against the graph's labels: button bit → label
 // index, −1 for none. A label the graph lacks is a ConfigError naming the key and

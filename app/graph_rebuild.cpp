@@ -14,18 +14,18 @@
 
 namespace marionette {
 
-graph::ClipDatabase load_graph_sources(const GraphSources& s, double analysis_rate_hz) {
-    const graph::LabelRules rules =
+offline::ClipDatabase load_graph_sources(const GraphSources& s, double analysis_rate_hz) {
+    const offline::LabelRules rules =
         s.labels.empty()
-            ? graph::parse_label_rules(std::string(embedded::find("config/graph_labels.toml")), "config/graph_labels.toml")
-            : graph::parse_label_rules(read_text_file(s.labels), s.labels);
-    return graph::load_clip_database(s.clips, s.asf, rules, analysis_rate_hz);
+            ? offline::parse_label_rules(std::string(embedded::find("config/graph_labels.toml")), "config/graph_labels.toml")
+            : offline::parse_label_rules(read_text_file(s.labels), s.labels);
+    return offline::load_clip_database(s.clips, s.asf, rules, analysis_rate_hz);
 }
 
-graph::GraphBuildOutput build_graph_from_sources(const graph::ClipDatabase& db, const GraphSources& s,
-                                                 const graph::GraphBuildParams& params,
-                                                 const graph::GraphBuildHooks& hooks) {
-    graph::GraphBuildOutput out = graph::build_motion_graph(db, params, hooks);
+offline::GraphBuildOutput build_graph_from_sources(const offline::ClipDatabase& db, const GraphSources& s,
+                                                 const offline::GraphBuildParams& params,
+                                                 const offline::GraphBuildHooks& hooks) {
+    offline::GraphBuildOutput out = offline::build_motion_graph(db, params, hooks);
     MotionGraph& g = out.graph;
     g.source_asf = s.asf;
     g.source_clips = db.source_files;
@@ -71,12 +71,12 @@ std::shared_ptr<const MotionGraph> load_graph_argument_rebuilding_stale(const st
                    argument, missing.size(), missing.size() == 1 ? "is" : "are", missing.front());
         return graph;
     }
-    graph::GraphBuildParams params = graph_build_params(config);
+    offline::GraphBuildParams params = graph_build_params(config);
     const auto started = std::chrono::steady_clock::now();
-    const graph::ClipDatabase db = load_graph_sources(sources, params.analysis_rate_hz);
-    const std::uint64_t current_hash = graph::graph_source_hash(db.content_hash, params);
+    const offline::ClipDatabase db = load_graph_sources(sources, params.analysis_rate_hz);
+    const std::uint64_t current_hash = offline::graph_source_hash(db.content_hash, params);
     if (current_hash == stored_hash) return graph;
-    graph::GraphBuildOutput out = build_graph_from_sources(db, sources, params);
+    offline::GraphBuildOutput out = build_graph_from_sources(db, sources, params);
     // The file keeps build_seconds 0 (same sources, same bytes); the time is only printed.
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     write_binary_file_atomically(argument, serialize_motion_graph(out.graph));

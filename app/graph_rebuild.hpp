@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "motion_graph/clip_database.hpp"
-#include "motion_graph/graph_builder.hpp"
-#include "runtime/motion_graph.hpp"
-#include "runtime/sim_config.hpp"
+#include "graph_builder/clip_database.hpp"
+#include "graph_builder/graph_builder.hpp"
+#include "runtime/graph/motion_graph.hpp"
+#include "runtime/sim/sim_config.hpp"
 
 namespace marionette {
 
@@ -22,14 +22,14 @@ struct GraphSources {
 };
 
 // Loads the label rules and the clip database (throws ImportError naming the file).
-graph::ClipDatabase load_graph_sources(const GraphSources& sources, double analysis_rate_hz);
+offline::ClipDatabase load_graph_sources(const GraphSources& sources, double analysis_rate_hz);
 
 // Builds the pruned graph from a database loaded by load_graph_sources and
 // records the sources in it (so the file can be rebuilt when stale). Throws
 // std::runtime_error when no strongly connected component remains.
-graph::GraphBuildOutput build_graph_from_sources(const graph::ClipDatabase& db, const GraphSources& sources,
-                                                 const graph::GraphBuildParams& params,
-                                                 const graph::GraphBuildHooks& hooks = {});
+offline::GraphBuildOutput build_graph_from_sources(const offline::ClipDatabase& db, const GraphSources& sources,
+                                                 const offline::GraphBuildParams& params,
+                                                 const offline::GraphBuildHooks& hooks = {});
 
 // Writes `bytes` to a temporary file beside `path` and renames it over `path`,
 // so a reader never sees a half-written file.

@@ -19,7 +19,7 @@
 #include "input/hid/hidapi_transport.hpp"
 #include "input/input_thread.hpp"
 #include "input/sdl/sdl_backend.hpp"
-#include "runtime/import_error.hpp"
+#include "runtime/errors/import_error.hpp"
 
 namespace marionette {
 

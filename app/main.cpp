@@ -4,7 +4,7 @@
 
 #include "app/cli.hpp"
 #include "app/config.hpp"
-#include "runtime/import_error.hpp"
+#include "runtime/errors/import_error.hpp"
 
 int main(int argc, char** argv) {
     using namespace marionette;

@@ -19,9 +19,9 @@
 #include "input/input_thread.hpp"
 #include "render_es/interpolate.hpp"
 #include "render_es/view.hpp"
-#include "runtime/det_math.hpp"
-#include "runtime/import_error.hpp"
-#include "runtime/fixed_step.hpp"
+#include "runtime/math/det_math.hpp"
+#include "runtime/errors/import_error.hpp"
+#include "runtime/sim/fixed_step.hpp"
 
 namespace marionette {
 

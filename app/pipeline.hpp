@@ -19,14 +19,14 @@
 
 #include "render_es/platform.hpp"
 #include "render_es/settings.hpp"
-#include "runtime/input_log.hpp"
-#include "runtime/latency_histogram.hpp"
-#include "runtime/latest_value.hpp"
-#include "runtime/motion_graph.hpp"
-#include "runtime/simulation.hpp"
-#include "runtime/spsc_ring.hpp"
-#include "runtime/stick_program.hpp"
-#include "runtime/tick_input_assembler.hpp"
+#include "runtime/formats/input_log.hpp"
+#include "runtime/handoff/latency_histogram.hpp"
+#include "runtime/handoff/latest_value.hpp"
+#include "runtime/graph/motion_graph.hpp"
+#include "runtime/sim/simulation.hpp"
+#include "runtime/handoff/spsc_ring.hpp"
+#include "runtime/formats/stick_program.hpp"
+#include "runtime/handoff/tick_input_assembler.hpp"
 
 namespace marionette {
 

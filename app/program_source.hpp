@@ -3,7 +3,7 @@
 // compiled into the binary from config/programs/NAME.prog.
 #include <string>
 
-#include "runtime/stick_program.hpp"
+#include "runtime/formats/stick_program.hpp"
 
 namespace marionette {
 StickProgram load_program(const std::string& spec);

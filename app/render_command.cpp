@@ -19,7 +19,7 @@
 #include "render_es/image.hpp"
 #include "render_es/interpolate.hpp"
 #include "render_es/view.hpp"
-#include "runtime/import_error.hpp"
+#include "runtime/errors/import_error.hpp"
 
 namespace marionette {
 

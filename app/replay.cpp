@@ -9,7 +9,7 @@
 #include "app/config.hpp"
 #include "app/files.hpp"
 #include "app/graph_files.hpp"
-#include "runtime/bvh.hpp"
+#include "runtime/formats/bvh.hpp"
 
 namespace marionette {
 

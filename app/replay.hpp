@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "runtime/input_log.hpp"
-#include "runtime/simulation.hpp"
+#include "runtime/formats/input_log.hpp"
+#include "runtime/sim/simulation.hpp"
 
 namespace marionette {
 

@@ -12,7 +12,7 @@
 
 #include <toml++/toml.h>
 
-#include "runtime/terrain.hpp"
+#include "runtime/ground/terrain.hpp"
 
 namespace marionette {
 

@@ -4,8 +4,8 @@
 // Run: build/release/bench/marionette_bench_gait
 #include <benchmark/benchmark.h>
 
-#include "runtime/simulation.hpp"
-#include "runtime/two_bone_ik.hpp"
+#include "runtime/sim/simulation.hpp"
+#include "runtime/anim/two_bone_ik.hpp"
 
 using namespace marionette;
 

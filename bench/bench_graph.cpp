@@ -16,13 +16,13 @@
 #include <random>
 
 #include "app/default_graph.hpp"
-#include "motion_graph/graph_builder.hpp"
-#include "runtime/det_math.hpp"
-#include "runtime/graph_controller.hpp"
-#include "runtime/graph_path.hpp"
+#include "graph_builder/graph_builder.hpp"
+#include "runtime/math/det_math.hpp"
+#include "runtime/graph/graph_controller.hpp"
+#include "runtime/graph/graph_path.hpp"
 
 using namespace marionette;
-using namespace marionette::graph;
+using namespace marionette::offline;
 
 namespace {
 

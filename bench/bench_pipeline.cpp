@@ -14,8 +14,8 @@
 #include "app/config.hpp"
 #include "app/pipeline.hpp"
 #include "app/program_source.hpp"
-#include "runtime/latest_value.hpp"
-#include "runtime/spsc_ring.hpp"
+#include "runtime/handoff/latest_value.hpp"
+#include "runtime/handoff/spsc_ring.hpp"
 
 using namespace marionette;
 

@@ -20,7 +20,7 @@
 #include <cstring>
 
 #include "render_es/view.hpp"
-#include "runtime/stick_program.hpp"
+#include "runtime/formats/stick_program.hpp"
 
 using namespace marionette;
 

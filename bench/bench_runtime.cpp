@@ -3,9 +3,9 @@
 // Run: build/release/bench/marionette_bench_runtime
 #include <benchmark/benchmark.h>
 
-#include "runtime/input_log.hpp"
-#include "runtime/puppet.hpp"
-#include "runtime/simulation.hpp"
+#include "runtime/formats/input_log.hpp"
+#include "runtime/gait/puppet.hpp"
+#include "runtime/sim/simulation.hpp"
 
 using namespace marionette;
 

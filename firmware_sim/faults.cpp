@@ -3,7 +3,7 @@
 #include <charconv>
 #include <cmath>
 
-#include "runtime/import_error.hpp"
+#include "runtime/errors/import_error.hpp"
 
 namespace marionette::firmware_sim {
 

@@ -10,7 +10,7 @@
 
 #include "firmware_sim/faults.hpp"
 #include "firmware_sim/report_encoders.hpp"
-#include "runtime/stick_program.hpp"
+#include "runtime/formats/stick_program.hpp"
 
 namespace marionette::firmware_sim {
 

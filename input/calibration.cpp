@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "runtime/import_error.hpp"
+#include "runtime/errors/import_error.hpp"
 
 namespace marionette::input {
 

@@ -4,8 +4,8 @@
 #include <cstdint>
 #include <string>
 
-#include "runtime/tick_input.hpp"
-#include "runtime/tick_input_assembler.hpp"
+#include "runtime/sim/tick_input.hpp"
+#include "runtime/handoff/tick_input_assembler.hpp"
 
 namespace marionette::input {
 
@@ -21,7 +21,7 @@ struct InputSample {
 };
 
 // The pipeline's view of a sample: quantised exactly as every other producer
-// of TickInputs quantises (runtime/tick_input.hpp).
+// of TickInputs quantises (runtime/sim/tick_input.hpp).
 TimedInput to_timed_input(const InputSample& sample);
 
 // Button names of a mask in Button order ("south", "east", ...).

@@ -23,8 +23,8 @@
 #include "input/calibration.hpp"
 #include "input/hid/hid_report.hpp"
 #include "input/hid/hid_transport.hpp"
-#include "runtime/spsc_ring.hpp"
-#include "runtime/tick_input_assembler.hpp"
+#include "runtime/handoff/spsc_ring.hpp"
+#include "runtime/handoff/tick_input_assembler.hpp"
 
 namespace marionette::input {
 

@@ -12,7 +12,7 @@ struct RadiusRule {
     const char* prefix;
     float radius;
 };
-// The default puppet (runtime/puppet.cpp): radii in metres of the bone each joint drives.
+// The default puppet (runtime/gait/puppet.cpp): radii in metres of the bone each joint drives.
 constexpr RadiusRule kRadii[] = {
     {"pelvis", 0.11f},   {"spine_01", 0.12f}, {"spine_02", 0.13f}, {"spine_03", 0.13f},
     {"neck", 0.05f},     {"head", 0.10f},     {"clavicle", 0.05f}, {"upperarm", 0.052f},

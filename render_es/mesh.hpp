@@ -7,8 +7,8 @@
 #include <span>
 #include <vector>
 
-#include "runtime/skeleton.hpp"
-#include "runtime/terrain.hpp"
+#include "runtime/anim/skeleton.hpp"
+#include "runtime/ground/terrain.hpp"
 
 namespace marionette::render {
 

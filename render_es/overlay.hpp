@@ -5,7 +5,7 @@
 #include <array>
 #include <cstdint>
 
-#include "runtime/math.hpp"
+#include "runtime/math/math.hpp"
 
 namespace marionette::render {
 

@@ -17,7 +17,7 @@
 #include "render_es/mesh.hpp"
 #include "render_es/overlay.hpp"
 #include "render_es/settings.hpp"
-#include "runtime/simulation.hpp"
+#include "runtime/sim/simulation.hpp"
 
 namespace marionette::render {
 

@@ -4,7 +4,7 @@
 // never recorded in input logs.
 #include <cstdint>
 
-#include "runtime/math.hpp"
+#include "runtime/math/math.hpp"
 
 namespace marionette::render {
 

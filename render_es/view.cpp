@@ -1,7 +1,7 @@
 #include "render_es/view.hpp"
 
 #include "render_es/image.hpp"
-#include "runtime/puppet.hpp"
+#include "runtime/gait/puppet.hpp"
 
 namespace marionette::render {
 

@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
 """Authors the default puppet's action clips (config/clips/*.bvh).
 
-Python standard library only. The hierarchy mirrors runtime/puppet.cpp's
+Python standard library only. The hierarchy mirrors runtime/gait/puppet.cpp's
 make_puppet_skeleton() with the default [puppet] proportions of
-runtime/sim_config.hpp (same joint names, order and offsets), so the clips import
-with runtime/bvh.hpp onto the puppet's own skeleton. Each clip is 30 Hz, starts
+runtime/sim/sim_config.hpp (same joint names, order and offsets), so the clips import
+with runtime/formats/bvh.hpp onto the puppet's own skeleton. Each clip is 30 Hz, starts
 and ends in the idle standing pose (arms hanging slightly out, elbows a little
 bent, as the gait stands) so the motion graph finds transitions into and out of it, and eases every
 curve in and out (smoothstep envelopes); secondary motion (head lag, counter
@@ -24,7 +24,7 @@ P = dict(pelvis_height=0.95, hip_width=0.18, thigh_length=0.44, shin_length=0.43
 
 
 def skeleton():
-    """(name, parent, offset, end_site_offset or None) in runtime/puppet.cpp's order."""
+    """(name, parent, offset, end_site_offset or None) in runtime/gait/puppet.cpp's order."""
     seg = P["spine_length"] / 3.0
     j = [("pelvis", -1, (0, P["pelvis_height"], 0), None),
          ("spine_01", 0, (0, 0.10, 0), None),
@@ -81,7 +81,7 @@ class Frame:
     def __init__(self, t, duration):
         self.root = [0.0, P["pelvis_height"], 0.0]
         self.rot = {name: [0.0, 0.0, 0.0] for name, _, _, _ in JOINTS}
-        # The gait's idle standing pose (runtime/gait.cpp with the default [gait]
+        # The gait's idle standing pose (runtime/gait/gait.cpp with the default [gait]
         # settings: pelvis 0.8425 m, knees soft, arms hanging forward and out; read
         # off `graph path --bvh` of the default graph's idle clip) with a slow
         # breath that starts and ends at zero over the clip.

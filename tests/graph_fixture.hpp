@@ -4,9 +4,9 @@
 // clips that walk straight, curve left, curve right, stand, and wave (labelled
 // "wave"), joined by transitions from frame 9 of every clip (4 blended frames) to frame 4 of every
 // clip, each aligned so the target clip continues where the source is.
-#include "runtime/det_math.hpp"
+#include "runtime/math/det_math.hpp"
 
-#include "runtime/motion_graph.hpp"
+#include "runtime/graph/motion_graph.hpp"
 
 namespace marionette::test {
 

@@ -8,7 +8,7 @@
 #include <cstring>
 #include <vector>
 
-#include "runtime/graph_path.hpp"
+#include "runtime/graph/graph_path.hpp"
 
 namespace marionette::test {
 

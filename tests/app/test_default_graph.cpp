@@ -10,12 +10,13 @@
 #include "app/default_graph.hpp"
 #include "app/embedded.hpp"
 #include "app/graph_files.hpp"
-#include "motion_graph/transition_search.hpp"
-#include "motion_graph/clip_database.hpp"
-#include "runtime/graph_path.hpp"
-#include "runtime/puppet.hpp"
-#include "runtime/simulation.hpp"
-#include "runtime/tick_input.hpp"
+#include "graph_builder/graph_prune.hpp"
+#include "graph_builder/transition_search.hpp"
+#include "graph_builder/clip_database.hpp"
+#include "runtime/graph/graph_path.hpp"
+#include "runtime/gait/puppet.hpp"
+#include "runtime/sim/simulation.hpp"
+#include "runtime/sim/tick_input.hpp"
 #include "tests/graph_path_check.hpp"
 
 using namespace marionette;
@@ -66,7 +67,7 @@ TEST_CASE("default graph: action clips import onto the puppet skeleton and start
         INFO(clip.name);
         CHECK(clip.name == default_action_clip_names()[i]);
         CHECK(validate_clip(clip).empty());
-        CHECK(graph::skeleton_mismatch(puppet, clip.skeleton).empty());
+        CHECK(offline::skeleton_mismatch(puppet, clip.skeleton).empty());
         CHECK(clip.frame_rate == Approx(30.0));
         CHECK(clip.duration() >= 1.0);
         CHECK(clip.duration() <= 3.0);
@@ -253,20 +254,20 @@ TEST_CASE("default graph: the tiled search finds exactly the reference's candida
     // are flat to ~1e-8 along the diagonal: a search that rounds more than the
     // reference would pick other minima there (the float sgemm path did); below
     // kDistanceNoiseFloor both count as 0.
-    const graph::GraphBuildParams params = graph_build_params(SimConfig{});
+    const offline::GraphBuildParams params = graph_build_params(SimConfig{});
     std::vector<Clip> clips = generate_locomotion_clips(SimConfig{}, params.analysis_rate_hz);
     for (Clip& c : default_action_clips()) clips.push_back(std::move(c));
-    const graph::LabelRules rules =
-        graph::parse_label_rules(std::string(embedded::find("config/graph_labels.toml")), "config/graph_labels.toml");
-    const graph::ClipDatabase db = graph::make_clip_database(std::move(clips), {}, rules, params.analysis_rate_hz);
-    const double leg = graph::skeleton_leg_length(db.skeleton, db.left_foot >= 0 ? db.left_foot : db.right_foot);
-    const std::vector<vec3> p = graph::database_positions(db);
-    const graph::FrameFeatures f = graph::compute_frame_features(db, p, params.window_frames, leg);
-    graph::CandidateSearchOptions o;
+    const offline::LabelRules rules =
+        offline::parse_label_rules(std::string(embedded::find("config/graph_labels.toml")), "config/graph_labels.toml");
+    const offline::ClipDatabase db = offline::make_clip_database(std::move(clips), {}, rules, params.analysis_rate_hz);
+    const double leg = offline::skeleton_leg_length(db.skeleton, db.left_foot >= 0 ? db.left_foot : db.right_foot);
+    const std::vector<vec3> p = offline::database_positions(db);
+    const offline::FrameFeatures f = offline::compute_frame_features(db, p, params.window_frames, leg);
+    offline::CandidateSearchOptions o;
     o.neighbourhood = params.neighbourhood_frames;
     o.threshold = default_build().output.threshold;
-    const graph::CandidateSearchResult tiled = graph::find_transition_candidates(f, o);
-    const graph::CandidateSearchResult reference = graph::find_transition_candidates_reference(db, p, f, leg, o);
+    const offline::CandidateSearchResult tiled = offline::find_transition_candidates(f, o);
+    const offline::CandidateSearchResult reference = offline::find_transition_candidates_reference(db, p, f, leg, o);
     CHECK(tiled.pair_evaluations == reference.pair_evaluations);
     REQUIRE(tiled.candidates.size() == reference.candidates.size());
     CHECK(tiled.candidates.size() > 100);

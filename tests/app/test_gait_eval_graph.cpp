@@ -10,7 +10,7 @@
 #include "app/default_graph.hpp"
 #include "app/gait_eval.hpp"
 #include "app/program_source.hpp"
-#include "runtime/simulation.hpp"
+#include "runtime/sim/simulation.hpp"
 
 using namespace marionette;
 

@@ -11,8 +11,8 @@
 #include "app/default_graph.hpp"
 #include "app/graph_files.hpp"
 #include "app/terrain_file.hpp"
-#include "runtime/puppet.hpp"
-#include "runtime/simulation.hpp"
+#include "runtime/gait/puppet.hpp"
+#include "runtime/sim/simulation.hpp"
 #include "tests/graph_fixture.hpp"
 
 using namespace marionette;

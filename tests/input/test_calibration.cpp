@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "input/calibration.hpp"
-#include "runtime/import_error.hpp"
+#include "runtime/errors/import_error.hpp"
 #include "tests/test_support.hpp"
 
 using namespace marionette;

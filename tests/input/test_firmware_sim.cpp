@@ -13,8 +13,8 @@
 #include "input/calibration.hpp"
 #include "input/hid/hid_pad.hpp"
 #include "input/input_thread.hpp"
-#include "runtime/import_error.hpp"
-#include "runtime/tick_input_assembler.hpp"
+#include "runtime/errors/import_error.hpp"
+#include "runtime/handoff/tick_input_assembler.hpp"
 #include "tests/alloc_counter.hpp"
 
 using namespace marionette;

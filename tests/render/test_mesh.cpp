@@ -7,7 +7,7 @@
 #include "render_es/camera.hpp"
 #include "render_es/interpolate.hpp"
 #include "render_es/mesh.hpp"
-#include "runtime/puppet.hpp"
+#include "runtime/gait/puppet.hpp"
 
 using namespace marionette;
 using namespace marionette::render;

@@ -18,7 +18,7 @@
 #include "render_es/gl_util.hpp"
 #include "render_es/image.hpp"
 #include "render_es/view.hpp"
-#include "runtime/puppet.hpp"
+#include "runtime/gait/puppet.hpp"
 #include "tests/alloc_counter.hpp"
 #include "tests/test_support.hpp"
 

@@ -10,9 +10,9 @@
 #include <thread>
 #include <vector>
 
-#include "runtime/latest_value.hpp"
-#include "runtime/spsc_ring.hpp"
-#include "runtime/tick_input_assembler.hpp"
+#include "runtime/handoff/latest_value.hpp"
+#include "runtime/handoff/spsc_ring.hpp"
+#include "runtime/handoff/tick_input_assembler.hpp"
 
 using namespace marionette;
 

@@ -1,0 +1,596 @@
+#include "graph_builder/transition_search.hpp"
+
+#include <cblas.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <memory>
+#include <thread>
+
+namespace marionette::offline {
+
+namespace {
+
+int thread_count(int requested) {
+    if (requested > 0) return requested;
+    const unsigned hw = std::thread::hardware_concurrency();
+    return hw > 0 ? static_cast<int>(hw) : 1;
+}
+
+// D from the window sums (see FrameFeatures): Ã and B̃ are the alignment's
+// centred dot and cross terms; the closed-form minimum over the rotation is
+// S_A + S_B − 2·Y − 2·sqrt(Ã² + B̃²).
+inline double distance_from_sums(const FrameFeatures& f, std::int32_t i, std::int32_t g, double sum_dot,
+                                 double sum_cross, double sum_y) {
+    const double k = f.window;
+    const size_t ui = static_cast<size_t>(i), ug = static_cast<size_t>(g);
+    const double dot = sum_dot, cross = sum_cross;
+    const double d = f.window_spread[ui] + f.window_spread[ug] - 2.0 * sum_y - 2.0 * std::sqrt(dot * dot + cross * cross);
+    const double v = d / (f.weight * k);
+    return v > kDistanceNoiseFloor ? v : 0.0;
+}
+
+// +inf, −1 (near-diagonal) or 0 (a pair to evaluate).
+inline float pair_status(const FrameFeatures& f, std::int32_t i, std::int32_t j) {
+    if (i < 0 || j < 0 || i >= f.frames || j >= f.frames) return kPairInvalid;
+    if (!f.start_ok[static_cast<size_t>(i)] || !f.end_ok[static_cast<size_t>(j)]) return kPairInvalid;
+    const std::int32_t g = j - f.window + 1;
+    if (f.clip_of[static_cast<size_t>(i)] == f.clip_of[static_cast<size_t>(g)] && std::abs(i - g) <= f.window)
+        return kPairExcluded;
+    return 0.0f;
+}
+
+// The local-minimum rule shared by the tiled and the reference search: below the
+// threshold, no excluded cell in the neighbourhood, strictly below every earlier
+// neighbour (raster order) and not above any later one, so plateaus give one minimum.
+template <typename Lookup>
+bool is_local_minimum(float v, std::int32_t i, std::int32_t j, int h, double threshold, Lookup&& at) {
+    if (v < 0.0f || v >= kPairInvalid || v > threshold) return false;
+    for (int di = -h; di <= h; ++di)
+        for (int dj = -h; dj <= h; ++dj) {
+            if (di == 0 && dj == 0) continue;
+            const float u = at(i + di, j + dj);
+            if (u < 0.0f || u < v) return false;
+            if (u == v && (di < 0 || (di == 0 && dj < 0))) return false;
+        }
+    return true;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::int32_t, std::int32_t>> local_minima(std::span<const float> m, std::int32_t rows,
+                                                               std::int32_t cols, int h, double threshold) {
+    const auto at = [&](std::int32_t i, std::int32_t j) -> float {
+        if (i < 0 || j < 0 || i >= rows || j >= cols) return kPairInvalid;
+        return m[static_cast<size_t>(i) * static_cast<size_t>(cols) + static_cast<size_t>(j)];
+    };
+    std::vector<std::pair<std::int32_t, std::int32_t>> out;
+    for (std::int32_t i = 0; i < rows; ++i)
+        for (std::int32_t j = 0; j < cols; ++j)
+            if (is_local_minimum(at(i, j), i, j, h, threshold, at)) out.push_back({i, j});
+    return out;
+}
+
+std::vector<vec3> database_positions(const ClipDatabase& db) {
+    const size_t joints = static_cast<size_t>(db.skeleton.joint_count());
+    std::vector<vec3> out(static_cast<size_t>(db.frame_count()) * joints);
+    std::vector<quat> model_rotations(joints);
+    size_t frame = 0;
+    for (const Clip& clip : db.clips)
+        for (int f = 0; f < clip.frame_count; ++f, ++frame) {
+            LocalToModelJob fk{db.skeleton.parents, std::span<const quat>(clip.frame_rotations(f), joints),
+                               std::span<const vec3>(clip.frame_translations(f), joints), model_rotations,
+                               std::span<vec3>(out.data() + frame * joints, joints)};
+            fk.run();
+        }
+    return out;
+}
+
+FrameFeatures compute_frame_features(const ClipDatabase& db, std::span<const vec3> positions, int window, double scale) {
+    FrameFeatures f;
+    f.frames = static_cast<std::int32_t>(db.frame_count());
+    f.joints = db.skeleton.joint_count();
+    f.window = window;
+    const size_t n = static_cast<size_t>(f.frames), J = static_cast<size_t>(f.joints);
+    const double inv_scale = 1.0 / scale;
+    std::vector<double> sqrt_w(J);
+    for (size_t j = 0; j < J; ++j) {
+        f.weight += db.joint_weights[j];
+        sqrt_w[j] = std::sqrt(static_cast<double>(db.joint_weights[j]));
+    }
+    const size_t width = 2 * J;  // xz: √w·q_x…, √w·q_z…
+    f.xz.resize(n * width);
+    f.zx.resize(n * width);
+    f.y.resize(n * J);
+    f.cx.resize(n);
+    f.cz.resize(n);
+    std::vector<double> spread(n);
+    f.clip_of.resize(n);
+    size_t at = 0;
+    for (size_t c = 0; c < db.clips.size(); ++c)
+        for (int i = 0; i < db.clips[c].frame_count; ++i) f.clip_of[at++] = static_cast<std::int32_t>(c);
+    for (size_t fr = 0; fr < n; ++fr) {
+        const vec3* p = positions.data() + fr * J;
+        double cx = 0.0, cz = 0.0;
+        for (size_t j = 0; j < J; ++j) {
+            cx += db.joint_weights[j] * (p[j].x * inv_scale);
+            cz += db.joint_weights[j] * (p[j].z * inv_scale);
+        }
+        f.cx[fr] = cx / f.weight;
+        f.cz[fr] = cz / f.weight;
+        double s = 0.0;
+        for (size_t j = 0; j < J; ++j) {
+            const double qx = sqrt_w[j] * (p[j].x * inv_scale - f.cx[fr]), qz = sqrt_w[j] * (p[j].z * inv_scale - f.cz[fr]);
+            const double qy = sqrt_w[j] * (p[j].y * inv_scale);
+            f.xz[fr * width + j] = qx;
+            f.xz[fr * width + J + j] = qz;
+            f.zx[fr * width + j] = qz;
+            f.zx[fr * width + J + j] = -qx;
+            f.y[fr * J + j] = qy;
+            s += qx * qx + qz * qz + qy * qy;
+        }
+        spread[fr] = s;
+    }
+    // Centroids relative to their clip's mean: the distance ignores any constant
+    // ground-plane shift of either window, and small numbers keep float products exact enough.
+    for (size_t c = 0, first = 0; c < db.clips.size(); first += static_cast<size_t>(db.clips[c].frame_count), ++c) {
+        const size_t count = static_cast<size_t>(db.clips[c].frame_count);
+        double mx = 0.0, mz = 0.0;
+        for (size_t fr = first; fr < first + count; ++fr) mx += f.cx[fr], mz += f.cz[fr];
+        mx /= static_cast<double>(count);
+        mz /= static_cast<double>(count);
+        for (size_t fr = first; fr < first + count; ++fr) f.cx[fr] -= mx, f.cz[fr] -= mz;
+    }
+    const size_t k = static_cast<size_t>(window);
+    f.start_ok.assign(n, 0);
+    f.end_ok.assign(n, 0);
+    f.window_spread.assign(n, 0.0);
+    f.window_cx.assign(n, 0.0);
+    f.window_cz.assign(n, 0.0);
+    for (size_t s = 0; s + k <= n; ++s) {
+        if (f.clip_of[s] != f.clip_of[s + k - 1]) continue;
+        f.start_ok[s] = 1;
+        f.end_ok[s + k - 1] = 1;
+        double sum = 0.0, sx = 0.0, sz = 0.0, cc = 0.0;
+        for (size_t t = 0; t < k; ++t) {
+            sum += spread[s + t];
+            sx += f.cx[s + t];
+            sz += f.cz[s + t];
+            cc += f.cx[s + t] * f.cx[s + t] + f.cz[s + t] * f.cz[s + t];
+        }
+        f.window_cx[s] = sx;
+        f.window_cz[s] = sz;
+        f.window_spread[s] = sum + f.weight * (cc - (sx * sx + sz * sz) / window);
+    }
+    return f;
+}
+
+double feature_pair_distance(const FrameFeatures& f, std::int32_t i, std::int32_t j) {
+    const float status = pair_status(f, i, j);
+    if (status != 0.0f) return status;
+    const std::int32_t g = j - f.window + 1;
+    const size_t J = static_cast<size_t>(f.joints);
+    double sd = 0.0, sc = 0.0, sy = 0.0;
+    for (int t = 0; t < f.window; ++t) {
+        const size_t a = static_cast<size_t>(i + t), b = static_cast<size_t>(g + t);
+        const size_t width = 2 * J;
+        for (size_t q = 0; q < width; ++q) {
+            sd += f.xz[a * width + q] * f.xz[b * width + q];
+            sc += f.xz[a * width + q] * f.zx[b * width + q];
+        }
+        for (size_t q = 0; q < J; ++q) sy += f.y[a * J + q] * f.y[b * J + q];
+    }
+    // The centroids' part: W·(Σ_t c_a·c_b − ΣA·ΣB / k), as the tiled search adds it.
+    double cd = 0.0, cc = 0.0;
+    for (int t = 0; t < f.window; ++t) {
+        const size_t a = static_cast<size_t>(i + t), b = static_cast<size_t>(g + t);
+        cd += f.cx[a] * f.cx[b] + f.cz[a] * f.cz[b];
+        cc += f.cx[a] * f.cz[b] - f.cz[a] * f.cx[b];
+    }
+    const size_t ui = static_cast<size_t>(i), ug = static_cast<size_t>(g);
+    sd += f.weight * cd - f.weight / f.window * (f.window_cx[ui] * f.window_cx[ug] + f.window_cz[ui] * f.window_cz[ug]);
+    sc += f.weight * cc - f.weight / f.window * (f.window_cx[ui] * f.window_cz[ug] - f.window_cz[ui] * f.window_cx[ug]);
+    return distance_from_sums(f, i, g, sd, sc, sy);
+}
+
+double reference_pair_distance(const ClipDatabase& db, std::span<const vec3> positions, int window, double scale,
+                               std::int32_t i, std::int32_t j, PlanarTransform* align) {
+    const size_t J = static_cast<size_t>(db.skeleton.joint_count());
+    const std::int32_t g = j - window + 1;
+    PlanarCrossSums sums;
+    for (int t = 0; t < window; ++t)
+        for (size_t q = 0; q < J; ++q)
+            accumulate_planar_sums(sums, positions[static_cast<size_t>(i + t) * J + q],
+                                   positions[static_cast<size_t>(g + t) * J + q], db.joint_weights[q]);
+    const PlanarTransform t = align_from_sums(sums);
+    if (align) *align = t;
+    double total = 0.0;
+    for (int s = 0; s < window; ++s) {
+        const std::span<const vec3> a(positions.data() + static_cast<size_t>(i + s) * J, J);
+        const std::span<const vec3> b(positions.data() + static_cast<size_t>(g + s) * J, J);
+        total += planar_cloud_distance(a, b, db.joint_weights, t);
+    }
+    double weight = 0.0;
+    for (float w : db.joint_weights) weight += w;
+    return total / (weight * window * scale * scale);
+}
+
+std::vector<double> distance_percentiles(const FrameFeatures& f, const std::vector<double>& percentiles,
+                                         std::int64_t max_samples) {
+    // (The sample size: the percentile of 65 536 pairs is within a fraction of a percent.)
+    std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
+    std::int64_t starts = 0, ends = 0;
+    for (std::int32_t i = 0; i < f.frames; ++i) {
+        starts += f.start_ok[static_cast<size_t>(i)];
+        ends += f.end_ok[static_cast<size_t>(i)];
+    }
+    if (starts * ends <= max_samples) {
+        for (std::int32_t i = 0; i < f.frames; ++i)
+            for (std::int32_t j = 0; j < f.frames; ++j)
+                if (pair_status(f, i, j) == 0.0f) pairs.push_back({i, j});
+    } else {
+        std::uint64_t state = 0x9e3779b97f4a7c15ull;  // fixed seed: the same sample every build
+        const auto next = [&state](std::int32_t n) {
+            state = state * 6364136223846793005ull + 1442695040888963407ull;
+            return static_cast<std::int32_t>((state >> 33) % static_cast<std::uint64_t>(n));
+        };
+        for (std::int64_t tries = 0; static_cast<std::int64_t>(pairs.size()) < max_samples && tries < 20 * max_samples; ++tries) {
+            const std::int32_t i = next(f.frames), j = next(f.frames);
+            if (pair_status(f, i, j) == 0.0f) pairs.push_back({i, j});
+        }
+    }
+    if (pairs.empty()) return std::vector<double>(percentiles.size(), 0.0);
+    std::vector<double> d(pairs.size());
+    const int threads = thread_count(0);
+    std::vector<std::thread> workers;
+    for (int t = 0; t < threads; ++t)
+        workers.emplace_back([&, t] {
+            for (size_t p = static_cast<size_t>(t); p < pairs.size(); p += static_cast<size_t>(threads))
+                d[p] = feature_pair_distance(f, pairs[p].first, pairs[p].second);
+        });
+    for (std::thread& w : workers) w.join();
+    std::sort(d.begin(), d.end());
+    std::vector<double> out;
+    for (double p : percentiles)
+        out.push_back(d[static_cast<size_t>(std::clamp(p, 0.0, 100.0) / 100.0 * static_cast<double>(d.size() - 1))]);
+    return out;
+}
+
+namespace {
+
+// out[r][c] = row (a_first + r) of `a` · row (b_first + c) of `b`, r < a_rows,
+// c < b_rows, rows `width` floats long: every cross term of a tile is one sgemm.
+void row_dots(const double* a, std::int32_t a_first, std::int32_t a_rows, const double* b, std::int32_t b_first,
+              std::int32_t b_rows, int width, double* out) {
+    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasTrans, a_rows, b_rows, width, 1.0,
+                a + static_cast<size_t>(a_first) * static_cast<size_t>(width), width,
+                b + static_cast<size_t>(b_first) * static_cast<size_t>(width), width, 0.0, out, b_rows);
+}
+
+// The per-row kernels of a tile are cloned for wider vector units where the
+// compiler can (the same IEEE adds, multiplies and square roots in the same order
+// per lane, and no contraction: every clone gives the same bits).
+#if defined(__x86_64__) && defined(__has_attribute)
+#if __has_attribute(target_clones)
+#define MARIONETTE_VECTOR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+#endif
+#ifndef MARIONETTE_VECTOR_CLONES
+#define MARIONETTE_VECTOR_CLONES
+#endif
+
+// The five window sums of a tile row, in double, each [c] for pair column c:
+// dot, cross and y cross terms (from the sgemm products) and the dot and cross
+// products of the frame centroids.
+enum WindowSum { kSumDot, kSumCross, kSumY, kSumCentroidDot, kSumCentroidCross, kSumCount };
+
+struct TileTerms {
+    const double* dot;   // [nr][nc] per-frame cross terms (dgemm)
+    const double* cross;
+    const double* y;
+    const double* row_cx;  // frame centroids of the tile's rows (nr) and columns (nc)
+    const double* row_cz;
+    const double* col_cx;
+    const double* col_cz;
+    size_t nc;
+};
+
+// Row r's sums from row r − 1's: pair (r, c)'s k-frame diagonal is pair
+// (r − 1, c − 1)'s with frame pair (r + k − 1, c + k − 1) entering and
+// (r − 1, c − 1) leaving. Double sums of float products are exact to ~1e-16, so
+// (the products are doubles: sliding along 500 diagonal steps costs ~1e-13). Columns c ≥ 1 only.
+MARIONETTE_VECTOR_CLONES void slide_window_sums(const TileTerms& m, std::int32_t r, std::int32_t k, std::int32_t dc,
+                                                const double* __restrict prev, double* __restrict cur) {
+    const size_t in = static_cast<size_t>(r + k - 1) * m.nc + static_cast<size_t>(k - 1);
+    const size_t out = static_cast<size_t>(r - 1) * m.nc;
+    const size_t n = static_cast<size_t>(dc);
+    const double* __restrict dot_in = m.dot + in;
+    const double* __restrict dot_out = m.dot + out;
+    const double* __restrict cross_in = m.cross + in;
+    const double* __restrict cross_out = m.cross + out;
+    const double* __restrict y_in = m.y + in;
+    const double* __restrict y_out = m.y + out;
+    for (size_t c = 1; c < n; ++c) {
+        cur[c] = prev[c - 1] + dot_in[c] - dot_out[c - 1];
+        cur[n + c] = prev[n + c - 1] + cross_in[c] - cross_out[c - 1];
+        cur[2 * n + c] = prev[2 * n + c - 1] + y_in[c] - y_out[c - 1];
+    }
+    const double ex = m.row_cx[r + k - 1], ez = m.row_cz[r + k - 1], lx = m.row_cx[r - 1], lz = m.row_cz[r - 1];
+    const double* __restrict cx_in = m.col_cx + (k - 1);
+    const double* __restrict cz_in = m.col_cz + (k - 1);
+    const double* __restrict cx_out = m.col_cx;
+    const double* __restrict cz_out = m.col_cz;
+    for (size_t c = 1; c < n; ++c) {
+        cur[3 * n + c] = prev[3 * n + c - 1] + (ex * cx_in[c] + ez * cz_in[c]) - (lx * cx_out[c - 1] + lz * cz_out[c - 1]);
+        cur[4 * n + c] = prev[4 * n + c - 1] + (ex * cz_in[c] - ez * cx_in[c]) - (lx * cz_out[c - 1] - lz * cx_out[c - 1]);
+    }
+}
+
+// The window sums of pair (r, c) summed directly over its k frames.
+void direct_window_sums(const TileTerms& m, std::int32_t r, std::int32_t c, std::int32_t k, std::int32_t dc, double* sums) {
+    const size_t n = static_cast<size_t>(dc), uc = static_cast<size_t>(c);
+    double s[kSumCount] = {};
+    for (std::int32_t t = 0; t < k; ++t) {
+        const size_t a = static_cast<size_t>(r + t), b = static_cast<size_t>(c + t);
+        const size_t at = a * m.nc + b;
+        s[kSumDot] += m.dot[at];
+        s[kSumCross] += m.cross[at];
+        s[kSumY] += m.y[at];
+        s[kSumCentroidDot] += m.row_cx[a] * m.col_cx[b] + m.row_cz[a] * m.col_cz[b];
+        s[kSumCentroidCross] += m.row_cx[a] * m.col_cz[b] - m.row_cz[a] * m.col_cx[b];
+    }
+    for (int q = 0; q < kSumCount; ++q) sums[static_cast<size_t>(q) * n + uc] = s[q];
+}
+
+struct RowWindow {
+    double spread;    // Σ w|p − centroid|² of window A
+    double sum_x, sum_z;  // Σ_t centroid of window A
+};
+
+// Distances of one tile row from its window sums, in double, rounded to float
+// once (as the reference's are): dot and cross are the frames' centred terms plus
+// the centroids' part W·(Σ c_a·c_b − ΣA·ΣB / k); D = S_A + S_B − 2Y − 2√(dot² + cross²).
+// col_x, col_z: W/k · Σ_t centroid of each column's window B.
+MARIONETTE_VECTOR_CLONES void window_distances(const double* __restrict sums, std::int32_t dc, RowWindow a, double weight,
+                                               double inv_wk, const double* __restrict col_spread,
+                                               const double* __restrict col_x, const double* __restrict col_z,
+                                               float* __restrict out) {
+    const size_t n = static_cast<size_t>(dc);
+    for (size_t c = 0; c < n; ++c) {
+        const double dot = sums[c] + (weight * sums[3 * n + c] - (a.sum_x * col_x[c] + a.sum_z * col_z[c]));
+        const double cross = sums[n + c] + (weight * sums[4 * n + c] - (a.sum_x * col_z[c] - a.sum_z * col_x[c]));
+        const double d = a.spread + col_spread[c] - 2.0 * sums[2 * n + c] - 2.0 * std::sqrt(dot * dot + cross * cross);
+        const double v = d * inv_wk;
+        out[c] = static_cast<float>(v > kDistanceNoiseFloor ? v : 0.0);
+    }
+}
+
+// A scratch array that grows but is never value-initialised: the tile buffers are
+// megabytes, every cell is written (dgemm with beta 0, the distance rows) before
+// it is read, and zero-filling them at every size change cost as much as the dgemm.
+template <typename T>
+struct ScratchArray {
+    std::unique_ptr<T[]> data_;
+    size_t size_ = 0;
+    void ensure(size_t n) {
+        if (n > size_) data_.reset(new T[n]), size_ = n;
+    }
+    T* data() { return data_.get(); }
+    const T* data() const { return data_.get(); }
+    T& operator[](size_t i) { return data_[i]; }
+};
+
+struct TileScratch {
+    ScratchArray<double> ca, cb, cy;      // per-frame cross terms of the tile (dgemm)
+    std::vector<double> row_cx, row_cz, col_cx, col_cz;  // frame centroids of its rows and columns
+    std::vector<double> sums[2];          // window sums of the previous and the current row
+    std::vector<double> col_spread, col_x, col_z;  // per column's window B
+    std::vector<std::int32_t> invalid_cols;
+    ScratchArray<float> d;                // distances of the tile plus halo
+    std::vector<TransitionCandidate> found;
+    std::vector<float> plot;
+    std::int64_t evaluations = 0;
+};
+
+void run_tile(const FrameFeatures& f, const CandidateSearchOptions& o, std::int32_t i0, std::int32_t i1,
+              std::int32_t j0, std::int32_t j1, TileScratch& s) {
+    const std::int32_t k = f.window, h = o.neighbourhood, N = f.frames;
+    const std::int32_t i_end = N - k + 1, j_begin = k - 1;  // valid i < i_end, j ≥ j_begin
+    const std::int32_t ci0 = std::max(i0, 0), ci1 = std::min(i1, i_end);
+    const std::int32_t cj0 = std::max(j0, j_begin), cj1 = std::min(j1, N);
+    if (ci0 >= ci1 || cj0 >= cj1) return;
+    const std::int32_t ei0 = std::max(ci0 - h, 0), ei1 = std::min(ci1 + h, i_end);
+    const std::int32_t ej0 = std::max(cj0 - h, j_begin), ej1 = std::min(cj1 + h, N);
+    const std::int32_t nr = ei1 - ei0 + k - 1, nc = ej1 - ej0 + k - 1;
+    const std::int32_t row0 = ei0, col0 = ej0 - k + 1;
+    const int J = f.joints, width = 2 * J;
+    const size_t cells = static_cast<size_t>(nr) * static_cast<size_t>(nc);
+    s.ca.ensure(cells);
+    s.cb.ensure(cells);
+    s.cy.ensure(cells);
+    // Cross terms of every frame pair of the tile: C[r][c] = frame (row0+r) · frame (col0+c).
+    row_dots(f.xz.data(), row0, nr, f.xz.data(), col0, nc, width, s.ca.data());
+    row_dots(f.xz.data(), row0, nr, f.zx.data(), col0, nc, width, s.cb.data());
+    row_dots(f.y.data(), row0, nr, f.y.data(), col0, nc, J, s.cy.data());
+
+    const std::int32_t dr = ei1 - ei0, dc = ej1 - ej0;
+    s.row_cx.assign(f.cx.begin() + row0, f.cx.begin() + row0 + nr);
+    s.row_cz.assign(f.cz.begin() + row0, f.cz.begin() + row0 + nr);
+    s.col_cx.assign(f.cx.begin() + col0, f.cx.begin() + col0 + nc);
+    s.col_cz.assign(f.cz.begin() + col0, f.cz.begin() + col0 + nc);
+    const TileTerms terms{s.ca.data(), s.cb.data(), s.cy.data(), s.row_cx.data(), s.row_cz.data(),
+                          s.col_cx.data(), s.col_cz.data(), static_cast<size_t>(nc)};
+
+    // Per column: window B's spread and W/k · Σ centroid; columns whose window leaves its clip.
+    const size_t udc = static_cast<size_t>(dc);
+    s.col_spread.resize(udc);
+    s.col_x.resize(udc);
+    s.col_z.resize(udc);
+    s.invalid_cols.clear();
+    const double w_over_k = f.weight / k;
+    for (std::int32_t c = 0; c < dc; ++c) {
+        const size_t g = static_cast<size_t>(col0 + c);
+        s.col_spread[static_cast<size_t>(c)] = f.window_spread[g];
+        s.col_x[static_cast<size_t>(c)] = w_over_k * f.window_cx[g];
+        s.col_z[static_cast<size_t>(c)] = w_over_k * f.window_cz[g];
+        if (!f.end_ok[static_cast<size_t>(ej0 + c)]) s.invalid_cols.push_back(c);
+    }
+    // Window sums row by row: row 0 and column 0 directly, the rest by sliding along
+    // the diagonals (two double adds per sum and pair instead of k).
+    s.d.ensure(static_cast<size_t>(dr) * udc);
+    s.sums[0].resize(kSumCount * udc);
+    s.sums[1].resize(kSumCount * udc);
+    const double inv_wk = 1.0 / (f.weight * k);
+    for (std::int32_t r = 0; r < dr; ++r) {
+        double* cur = s.sums[static_cast<size_t>(r & 1)].data();
+        const double* prev = s.sums[static_cast<size_t>((r + 1) & 1)].data();
+        if (r == 0) {
+            for (std::int32_t c = 0; c < dc; ++c) direct_window_sums(terms, 0, c, k, dc, cur);
+        } else {
+            direct_window_sums(terms, r, 0, k, dc, cur);
+            slide_window_sums(terms, r, k, dc, prev, cur);
+        }
+        const std::int32_t i = ei0 + r;
+        const size_t ui = static_cast<size_t>(i);
+        float* __restrict out = s.d.data() + static_cast<size_t>(r) * udc;
+        if (!f.start_ok[ui]) {
+            std::fill(out, out + dc, kPairInvalid);
+            continue;
+        }
+        // Branch-free over the row (it vectorises); invalid and near-diagonal pairs
+        // are patched afterwards from short lists.
+        window_distances(cur, dc, RowWindow{f.window_spread[ui], f.window_cx[ui], f.window_cz[ui]}, f.weight, inv_wk,
+                         s.col_spread.data(), s.col_x.data(), s.col_z.data(), out);
+        for (const std::int32_t c : s.invalid_cols) out[c] = kPairInvalid;
+        // Same clip and windows starting at most k frames apart: g ∈ [i − k, i + k].
+        const std::int32_t c_lo = std::max(i - k - col0, 0), c_hi = std::min(i + k - col0, dc - 1);
+        for (std::int32_t c = c_lo; c <= c_hi; ++c)
+            if (f.clip_of[static_cast<size_t>(col0 + c)] == f.clip_of[ui] && out[c] != kPairInvalid) out[c] = kPairExcluded;
+    }
+
+    std::map<std::pair<std::int32_t, std::int32_t>, std::vector<TransitionCandidate>> bridges;
+    const auto at = [&](std::int32_t i, std::int32_t j) -> float {
+        if (i < ei0 || i >= ei1 || j < ej0 || j >= ej1) return kPairInvalid;  // outside the valid range
+        return s.d[static_cast<size_t>(i - ei0) * static_cast<size_t>(dc) + static_cast<size_t>(j - ej0)];
+    };
+    const double keep_below = std::max(o.threshold, o.bridge_threshold);
+    for (std::int32_t i = ci0; i < ci1; ++i) {
+        const float* __restrict row = s.d.data() + static_cast<size_t>(i - ei0) * udc;  // row[j − ej0]
+        std::int64_t evaluated = 0;  // (a separate branch-free loop: it vectorises)
+        for (std::int32_t c = cj0 - ej0; c < cj1 - ej0; ++c) evaluated += row[c] >= 0.0f && row[c] < kPairInvalid;
+        s.evaluations += evaluated;
+        if (o.plot)
+            for (std::int32_t j = cj0; j < cj1; ++j) {
+                const float v = row[j - ej0];
+                if (!(v >= 0.0f && v < kPairInvalid)) continue;
+                const size_t px = static_cast<size_t>(static_cast<std::int64_t>(i) * o.plot_size / N);
+                const size_t py = static_cast<size_t>(static_cast<std::int64_t>(j) * o.plot_size / N);
+                float& pixel = s.plot[px * static_cast<size_t>(o.plot_size) + py];
+                pixel = std::min(pixel, v);
+            }
+        for (std::int32_t j = cj0; j < cj1; ++j) {
+            const float v = row[j - ej0];
+            if (!(v >= 0.0f) || static_cast<double>(v) > keep_below) continue;  // (also the absent pairs)
+            // Most cells below the threshold lie on a valley's slope: a smaller (or
+            // excluded) direct neighbour rejects them before the full neighbourhood.
+            const float n0 = at(i, j - 1), n1 = at(i, j + 1), n2 = at(i - 1, j), n3 = at(i + 1, j);
+            if (n0 < v || n1 < v || n2 < v || n3 < v) continue;
+            const float n4 = at(i - 1, j - 1), n5 = at(i + 1, j + 1), n6 = at(i - 1, j + 1), n7 = at(i + 1, j - 1);
+            if (n4 < v || n5 < v || n6 < v || n7 < v) continue;
+            if (!is_local_minimum(v, i, j, h, keep_below, at)) continue;
+            if (v <= o.threshold) {
+                s.found.push_back({i, j, v});
+                continue;
+            }
+            auto& best = bridges[{f.clip_of[static_cast<size_t>(i)], f.clip_of[static_cast<size_t>(j)]}];
+            best.push_back({i, j, v});
+            std::sort(best.begin(), best.end(),
+                      [](const TransitionCandidate& a, const TransitionCandidate& b) { return a.distance < b.distance; });
+            if (best.size() > static_cast<size_t>(o.bridges_per_clip_pair)) best.pop_back();
+        }
+    }
+    for (const auto& [clips, best] : bridges) s.found.insert(s.found.end(), best.begin(), best.end());
+}
+
+}  // namespace
+
+CandidateSearchResult find_transition_candidates(const FrameFeatures& f, const CandidateSearchOptions& o) {
+    openblas_set_num_threads(1);  // parallel over tiles instead: one sgemm per thread at a time
+    const std::int32_t T = std::max(16, o.tile);
+    const std::int32_t tiles_per_side = (f.frames + T - 1) / T;
+    const std::int64_t tile_count = static_cast<std::int64_t>(tiles_per_side) * tiles_per_side;
+    const int threads = static_cast<int>(std::min<std::int64_t>(thread_count(o.threads), std::max<std::int64_t>(tile_count, 1)));
+    std::vector<TileScratch> scratch(static_cast<size_t>(threads));
+    {  // the largest tile plus halo, once: no reallocation as tile sizes vary
+        const size_t side = static_cast<size_t>(std::min(T + 2 * o.neighbourhood + f.window - 1, std::max(f.frames, 1)));
+        for (TileScratch& s : scratch) {
+            s.ca.ensure(side * side), s.cb.ensure(side * side), s.cy.ensure(side * side);
+            s.d.ensure(side * side);
+        }
+    }
+    if (o.plot)
+        for (TileScratch& s : scratch)
+            s.plot.assign(static_cast<size_t>(o.plot_size) * static_cast<size_t>(o.plot_size), kPairInvalid);
+    std::atomic<std::int64_t> next{0}, done{0};
+    const auto work = [&](int t) {
+        for (std::int64_t tile = next++; tile < tile_count; tile = next++) {
+            const std::int32_t ti = static_cast<std::int32_t>(tile / tiles_per_side);
+            const std::int32_t tj = static_cast<std::int32_t>(tile % tiles_per_side);
+            run_tile(f, o, ti * T, (ti + 1) * T, tj * T, (tj + 1) * T, scratch[static_cast<size_t>(t)]);
+            ++done;
+            if (t == 0 && o.progress) o.progress(static_cast<double>(done.load()) / static_cast<double>(tile_count));
+        }
+    };
+    std::vector<std::thread> workers;
+    for (int t = 1; t < threads; ++t) workers.emplace_back(work, t);
+    work(0);
+    for (std::thread& w : workers) w.join();
+    if (o.progress) o.progress(1.0);
+
+    CandidateSearchResult out;
+    for (TileScratch& s : scratch) {
+        out.candidates.insert(out.candidates.end(), s.found.begin(), s.found.end());
+        out.pair_evaluations += s.evaluations;
+    }
+    std::sort(out.candidates.begin(), out.candidates.end(), [](const TransitionCandidate& a, const TransitionCandidate& b) {
+        return a.from_frame != b.from_frame ? a.from_frame < b.from_frame : a.to_frame < b.to_frame;
+    });
+    if (o.plot) {
+        o.plot->assign(static_cast<size_t>(o.plot_size) * static_cast<size_t>(o.plot_size), kPairInvalid);
+        for (const TileScratch& s : scratch)
+            for (size_t p = 0; p < o.plot->size(); ++p) (*o.plot)[p] = std::min((*o.plot)[p], s.plot[p]);
+    }
+    return out;
+}
+
+CandidateSearchResult find_transition_candidates_reference(const ClipDatabase& db, std::span<const vec3> positions,
+                                                           const FrameFeatures& f, double scale,
+                                                           const CandidateSearchOptions& o) {
+    const std::int32_t N = f.frames;
+    std::vector<float> d(static_cast<size_t>(N) * static_cast<size_t>(N));
+    CandidateSearchResult out;
+    for (std::int32_t i = 0; i < N; ++i)
+        for (std::int32_t j = 0; j < N; ++j) {
+            float v = pair_status(f, i, j);
+            if (v == 0.0f) {
+                const double r = reference_pair_distance(db, positions, f.window, scale, i, j);
+                v = static_cast<float>(r > kDistanceNoiseFloor ? r : 0.0);
+                ++out.pair_evaluations;
+            }
+            d[static_cast<size_t>(i) * static_cast<size_t>(N) + static_cast<size_t>(j)] = v;
+        }
+    const auto at = [&](std::int32_t i, std::int32_t j) -> float {
+        if (i < 0 || j < 0 || i >= N || j >= N) return kPairInvalid;
+        return d[static_cast<size_t>(i) * static_cast<size_t>(N) + static_cast<size_t>(j)];
+    };
+    for (std::int32_t i = 0; i < N; ++i)
+        for (std::int32_t j = 0; j < N; ++j)
+            if (is_local_minimum(at(i, j), i, j, o.neighbourhood, o.threshold, at))
+                out.candidates.push_back({i, j, at(i, j)});  // regular candidates only
+    return out;
+}
+
+}  // namespace marionette::offline

@@ -1,0 +1,162 @@
+#include "runtime/anim/foot_placement.hpp"
+
+#include <cmath>
+
+#include "runtime/anim/skeleton.hpp"
+#include "runtime/anim/two_bone_ik.hpp"
+
+namespace marionette {
+
+namespace {
+float clamp01(float v) { return v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v); }
+float smoothstep(float u) { return u * u * (3.0f - 2.0f * u); }
+float length_of(vec3 v) { return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z); }
+vec3 unit_or(vec3 v, vec3 fallback) {
+    const float n = length_of(v);
+    return n > 1e-6f ? v / n : fallback;
+}
+bool finite(vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+}  // namespace
+
+FootPlacementRig make_foot_placement_rig(std::span<const int> parents, int left_ankle, int right_ankle) {
+    FootPlacementRig rig;
+    const int count = static_cast<int>(parents.size());
+    for (int j = 0; j < count; ++j)
+        if (parents[static_cast<size_t>(j)] == kNoParent) {
+            rig.root = j;
+            break;
+        }
+    const int ankles[2] = {left_ankle, right_ankle};
+    rig.valid = true;
+    for (int i = 0; i < 2; ++i) {
+        FootPlacementLeg& leg = rig.legs[static_cast<size_t>(i)];
+        const int ankle = ankles[i];
+        const int knee = ankle >= 0 && ankle < count ? parents[static_cast<size_t>(ankle)] : kNoParent;
+        const int hip = knee >= 0 ? parents[static_cast<size_t>(knee)] : kNoParent;
+        if (hip < 0 || hip == rig.root) {
+            rig.valid = false;
+            continue;
+        }
+        leg = {hip, knee, ankle};
+    }
+    return rig;
+}
+
+bool FootPlacementJob::validate() const {
+    const size_t n = parents.size();
+    if (!state || !rig || !terrain || !rig->valid || !(dt >= 0.0f) || !(release_s >= 0.0f) || !(terrain_rate > 0.0f)) return false;
+    if (local_rotations.size() != n || local_translations.size() != n || model_rotations.size() != n || model_positions.size() != n)
+        return false;
+    for (const FootPlacementLeg& leg : rig->legs)
+        if (leg.ankle < 0 || static_cast<size_t>(leg.ankle) >= n) return false;
+    return static_cast<size_t>(rig->root) < n;
+}
+
+void FootPlacementJob::run() const {
+    if (!validate()) return;
+    FootPlacementState& s = *state;
+    const vec3 up(0.0f, 1.0f, 0.0f);
+
+    // Each foot's ground: under it, or higher just ahead of it; eased, so a step
+    // up lifts the foot over a few ticks instead of at once.
+    GroundSample sample[2];
+    bool slow[2];
+    for (int i = 0; i < 2; ++i) {
+        FootPin& pin = s.feet[static_cast<size_t>(i)];
+        const vec3 a = model_positions[static_cast<size_t>(rig->legs[static_cast<size_t>(i)].ankle)];
+        sample[i] = query_ground(*terrain, a.x, a.z);
+        const vec3 moved = s.started ? a - pin.clip_previous : vec3(0.0f);
+        const float step = std::sqrt(moved.x * moved.x + moved.z * moved.z);
+        slow[i] = !(dt > 0.0f) || step <= kPinMaxSpeed * dt;
+        float wanted = sample[i].height;
+        if (step > 1e-6f) {
+            const float ahead = max_height_along(*terrain, a.x, a.z, a.x + moved.x / step * kFootLookAheadM,
+                                                 a.z + moved.z / step * kFootLookAheadM, 0.05f);
+            wanted = ahead > wanted ? ahead : wanted;
+        }
+        if (!s.started || pin.contact == 1) pin.ground = sample[i].height;
+        else {
+            const float limit = kFootGroundSpeed * dt;
+            const float change = wanted - pin.ground;
+            pin.ground += change > limit ? limit : (change < -limit ? -limit : change);
+        }
+        pin.clip_previous = a;
+    }
+    // The body follows the lower of the two feet's grounds.
+    const float lowest = s.feet[0].ground < s.feet[1].ground ? s.feet[0].ground : s.feet[1].ground;
+    if (!s.started) s.body_offset = lowest;
+    else s.body_offset += (lowest - s.body_offset) * clamp01(terrain_rate * dt);
+    const size_t root = static_cast<size_t>(rig->root);
+    local_translations[root].y += s.body_offset;
+    for (vec3& p : model_positions) p.y += s.body_offset;
+
+    const vec3 forward = quat_rotate(model_rotations[root], vec3(0.0f, 0.0f, 1.0f));
+    for (int i = 0; i < 2; ++i) {
+        const FootPlacementLeg& leg = rig->legs[static_cast<size_t>(i)];
+        FootPin& pin = s.feet[static_cast<size_t>(i)];
+        const size_t hip = static_cast<size_t>(leg.hip), knee = static_cast<size_t>(leg.knee),
+                     ankle = static_cast<size_t>(leg.ankle);
+        // The clip's ankle, as high above the ground under it as it was above its flat floor.
+        const vec3 free = model_positions[ankle] + vec3(0.0f, pin.ground - s.body_offset, 0.0f);
+        const bool contact = ((contacts >> i) & 1u) && slow[i];
+        if (contact && pin.contact == 0) {
+            pin.pin = s.started ? pin.placed : free;
+            pin.contact = 1;
+        } else if (!contact && pin.contact != 0) {
+            pin.contact = 0;
+            pin.release = 0.0f;
+        }
+        if (pin.contact == 1) {
+            const float sx = pin.pin.x - free.x, sz = pin.pin.z - free.z;
+            if (sx * sx + sz * sz > kMaxPinSlipM * kMaxPinSlipM) {
+                pin.contact = 2;
+                pin.pin = pin.placed;
+                pin.release = 0.0f;
+            }
+        }
+        if (pin.contact == 1) pin.release = 0.0f;
+        else pin.release = release_s > 0.0f ? clamp01(pin.release + dt / release_s) : 1.0f;
+        if (!s.started) pin.release = pin.contact == 1 ? 0.0f : 1.0f;
+        // The tilt to the ground eases in and out over release_s as well: a foot
+        // landing on a slope must not snap to it.
+        const float plant_step = release_s > 0.0f ? dt / release_s : 1.0f;
+        pin.plant = !s.started ? (pin.contact == 1 ? 1.0f : 0.0f)
+                               : clamp01(pin.plant + (pin.contact == 1 ? plant_step : -plant_step));
+        const vec3 target = lerp(pin.pin, free, smoothstep(pin.release));
+
+        const vec3 h = model_positions[hip], k = model_positions[knee], a = model_positions[ankle];
+        TwoBoneIkInput ik;
+        ik.root = h;
+        ik.target = target;
+        ik.pole = unit_or(k - 0.5f * (h + a), forward);
+        ik.upper_length = length_of(local_translations[knee]);
+        ik.lower_length = length_of(local_translations[ankle]);
+        if (!ik.validate() || !finite(target)) continue;
+        const TwoBoneIkResult r = solve_two_bone_ik(ik);
+        // Turn the clip's thigh and shin onto the solved bones (shortest arcs), so
+        // the skeleton's own segment frames and twist are kept.
+        const quat turn_upper = quat_from_to(unit_or(k - h, -up), unit_or(r.mid - h, -up));
+        const vec3 lower_before = quat_rotate(turn_upper, unit_or(a - k, -up));
+        const quat turn_lower = quat_from_to(lower_before, unit_or(r.end - r.mid, -up));
+        const quat hip_world = quat_normalize(quat_mul(turn_upper, model_rotations[hip]));
+        const quat knee_world = quat_normalize(quat_mul(turn_lower, quat_mul(turn_upper, model_rotations[knee])));
+        // A planted foot lies on the ground's slope; a lifted one keeps the clip's.
+        // (The normal under the target, not under the clip's foot: a pinned foot
+        // must not tilt because the clip's foot slid over a slope's edge.)
+        const vec3 normal = query_ground(*terrain, target.x, target.z).normal;
+        const quat tilt = quat_slerp(quat_identity(), quat_from_to(up, normal), smoothstep(pin.plant));
+        const quat foot_world = quat_normalize(quat_mul(tilt, model_rotations[ankle]));
+        const int hip_parent = parents[hip];
+        const quat parent_world = hip_parent >= 0 ? model_rotations[static_cast<size_t>(hip_parent)] : quat_identity();
+        local_rotations[hip] = quat_normalize(quat_mul(quat_conjugate(parent_world), hip_world));
+        local_rotations[knee] = quat_normalize(quat_mul(quat_conjugate(hip_world), knee_world));
+        local_rotations[ankle] = quat_normalize(quat_mul(quat_conjugate(knee_world), foot_world));
+    }
+    const LocalToModelJob fk{parents, local_rotations, local_translations, model_rotations, model_positions};
+    fk.run();
+    for (int i = 0; i < 2; ++i)
+        s.feet[static_cast<size_t>(i)].placed = model_positions[static_cast<size_t>(rig->legs[static_cast<size_t>(i)].ankle)];
+    s.started = 1;
+}
+
+}  // namespace marionette

@@ -1,0 +1,89 @@
+#pragma once
+// Procedural foot placement on top of a clip pose (the motion graph's
+// `graph_feet` source): the clip was recorded on flat ground and its blends
+// slide the feet a little, so
+//   - the body is raised to the ground under the feet (the lower of the two, so
+//     the other leg bends to reach its higher ground), following at a rate;
+//   - each foot the clip marks in contact, and that the clip moves slower than
+//     kPinMaxSpeed, is pinned where it touched down and held there by the two-bone
+//     IK until the clip lifts it; then it eases back to the clip's own path;
+//   - a foot is placed on its own ground height, which eases (at most
+//     kFootGroundSpeed) toward the highest ground under it and up to
+//     kFootLookAheadM ahead of it, so a foot rises onto a step before its toes
+//     reach the riser, not at it;
+//   - a planted foot tilts to the ground's normal.
+// A job in the ozz style: plain state in, spans in and out, no allocation. The
+// legs are found by joint index (hip = knee's parent, knee = ankle's parent),
+// so it works for any skeleton whose foot joints the graph names; segment
+// lengths are read from the pose's own local translations, so scaled graphs work.
+#include <array>
+#include <cstdint>
+#include <span>
+
+#include "runtime/math/math.hpp"
+#include "runtime/ground/terrain.hpp"
+
+namespace marionette {
+
+struct FootPin {
+    vec3 pin{0.0f};              // where the ankle is held while the clip's foot is in contact (world, m)
+    vec3 placed{0.0f};           // where the ankle was put last tick: a new pin starts there, so nothing jumps
+    vec3 clip_previous{0.0f};    // the clip's ankle last tick (world, before placement): its speed
+    float ground = 0.0f;         // ground height the foot is placed on, eased toward the ground ahead of it
+    float release = 1.0f;        // 0 held at the pin … 1 following the clip's foot
+    float plant = 0.0f;          // 0 the clip's foot rotation … 1 tilted to the ground: eased both ways
+    std::int32_t contact = 0;    // 0 free, 1 pinned, 2 in contact but let go (the pin slipped too far from the clip)
+};
+
+struct FootPlacementState {
+    std::array<FootPin, 2> feet{};
+    float body_offset = 0.0f;    // metres the body is raised to meet the ground
+    std::int32_t started = 0;    // 0 until a tick has placed the feet
+};
+
+struct FootPlacementLeg {
+    std::int32_t hip = -1, knee = -1, ankle = -1;
+};
+
+struct FootPlacementRig {
+    std::array<FootPlacementLeg, 2> legs{};  // left, right
+    std::int32_t root = 0;
+    bool valid = false;          // both legs have hip, knee and ankle joints
+};
+
+// The legs of a skeleton from its foot (ankle) joints; invalid when a foot is
+// missing or has fewer than two ancestors below the root.
+FootPlacementRig make_foot_placement_rig(std::span<const int> parents, int left_ankle, int right_ankle);
+
+// A pin that drifts this far (horizontally) from the clip's foot is let go, so a
+// long blend cannot stretch the leg out of reach.
+inline constexpr float kMaxPinSlipM = 0.25f;
+// The clip's contact flags come from thresholds loose enough for any capture; a
+// foot the clip still moves faster than this (m/s, on the ground plane) is not pinned.
+inline constexpr float kPinMaxSpeed = 0.35f;
+// How fast (m/s) a foot's ground height may change, and how far ahead (m) of the
+// ankle, along its motion, the highest ground is looked for: past the toes of an
+// adult foot, so the toes clear a riser the ankle has not reached.
+inline constexpr float kFootGroundSpeed = 3.0f;
+inline constexpr float kFootLookAheadM = 0.35f;
+
+struct FootPlacementJob {
+    FootPlacementState* state = nullptr;
+    const FootPlacementRig* rig = nullptr;
+    const Terrain* terrain = nullptr;
+    std::uint8_t contacts = 0;     // the clip pose's contacts: bit 0 left, bit 1 right
+    float dt = 0.0f;               // seconds since the last tick (0: place without advancing)
+    float release_s = 0.15f;
+    float terrain_rate = 10.0f;    // 1/s
+    std::span<const int> parents;
+    // In: the clip pose (locals) and its forward kinematics. Out: the placed pose, both.
+    std::span<quat> local_rotations;
+    std::span<vec3> local_translations;
+    std::span<quat> model_rotations;
+    std::span<vec3> model_positions;
+
+    bool validate() const;
+    void run() const;
+};
+
+}  // namespace marionette

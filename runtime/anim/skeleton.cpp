@@ -1,0 +1,68 @@
+#include "runtime/anim/skeleton.hpp"
+
+#include <map>
+
+namespace marionette {
+
+int Skeleton::find(std::string_view name) const {
+    for (int i = 0; i < joint_count(); ++i)
+        if (joint_names[static_cast<size_t>(i)] == name) return i;
+    return -1;
+}
+
+std::string validate_skeleton(const Skeleton& s) {
+    const size_t n = s.parents.size();
+    if (s.joint_names.size() != n || s.rest_offsets.size() != n)
+        return "joint name, parent and offset arrays differ in size";
+    if (n == 0) return "skeleton has no joints";
+    std::map<std::string_view, size_t> seen;
+    for (size_t i = 0; i < n; ++i) {
+        if (s.parents[i] != kNoParent && (s.parents[i] < 0 || static_cast<size_t>(s.parents[i]) >= i))
+            return "joint '" + s.joint_names[i] + "' has parent index " + std::to_string(s.parents[i]) +
+                   ", which is not an earlier joint";
+        if (s.joint_names[i].empty()) return "joint " + std::to_string(i) + " has an empty name";
+        auto [it, inserted] = seen.emplace(s.joint_names[i], i);
+        if (!inserted) return "duplicate joint name '" + s.joint_names[i] + "'";
+    }
+    if (s.end_site_parents.size() != s.end_site_offsets.size())
+        return "end site parent and offset arrays differ in size";
+    for (int p : s.end_site_parents)
+        if (p < 0 || static_cast<size_t>(p) >= n) return "end site has an invalid parent index";
+    return {};
+}
+
+Pose rest_pose(const Skeleton& s) {
+    Pose pose;
+    pose.local_rotations.assign(s.parents.size(), quat_identity());
+    pose.local_translations = s.rest_offsets;
+    return pose;
+}
+
+bool LocalToModelJob::validate() const {
+    const size_t n = parents.size();
+    if (local_rotations.size() != n || local_translations.size() != n ||
+        model_rotations.size() < n || model_positions.size() < n)
+        return false;
+    for (size_t i = 0; i < n; ++i)
+        if (parents[i] != kNoParent && (parents[i] < 0 || static_cast<size_t>(parents[i]) >= i))
+            return false;
+    return true;
+}
+
+void LocalToModelJob::run() const {
+    const size_t n = parents.size();
+    for (size_t i = 0; i < n; ++i) {
+        const int p = parents[i];
+        if (p == kNoParent) {
+            model_rotations[i] = local_rotations[i];
+            model_positions[i] = local_translations[i];
+        } else {
+            const quat parent_rotation = model_rotations[static_cast<size_t>(p)];
+            model_rotations[i] = quat_mul(parent_rotation, local_rotations[i]);
+            model_positions[i] =
+                model_positions[static_cast<size_t>(p)] + quat_rotate(parent_rotation, local_translations[i]);
+        }
+    }
+}
+
+}  // namespace marionette

@@ -1,0 +1,722 @@
+#include "runtime/gait/gait.hpp"
+
+#include <cmath>
+
+#include "runtime/gait/puppet.hpp"
+#include "runtime/anim/skeleton.hpp"
+#include "runtime/anim/two_bone_ik.hpp"
+
+namespace marionette {
+
+namespace {
+
+float dot3(vec3 a, vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+vec3 cross3(vec3 a, vec3 b) { return vec3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x); }
+float length3(vec3 v) { return std::sqrt(dot3(v, v)); }
+vec3 normalize3(vec3 v, vec3 fallback) {
+    const float n = length3(v);
+    return n > 1e-9f ? v / n : fallback;
+}
+float clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
+float maxf(float a, float b) { return a > b ? a : b; }
+float minf(float a, float b) { return a < b ? a : b; }
+float frac(float v) { return v - std::floor(v); }
+float horizontal_distance(vec3 a, vec3 b) {
+    const float dx = a.x - b.x, dz = a.z - b.z;
+    return std::sqrt(dx * dx + dz * dz);
+}
+// Exponential approach without exp: the fraction min(1, rate·dt) per tick.
+float approach(float value, float target, float rate, float dt) { return value + (target - value) * minf(1.0f, rate * dt); }
+
+struct HeadingFrame {
+    vec3 forward;  // (sin h, 0, cos h)
+    vec3 left;     // (cos h, 0, −sin h): the puppet's +X
+};
+HeadingFrame heading_frame(double heading) {
+    double s = 0.0, c = 0.0;
+    det::sin_cos(heading, s, c);
+    return {vec3(static_cast<float>(s), 0.0f, static_cast<float>(c)), vec3(static_cast<float>(c), 0.0f, static_cast<float>(-s))};
+}
+float side_sign(int foot) { return foot == 0 ? 1.0f : -1.0f; }  // left foot is on +X
+
+// Prototype → Hermite keys. Tangents from the neighbours (Catmull–Rom on uneven
+// phases); a looping path wraps them, an open one (swing) starts and ends at rest.
+int build_prototype_keys(const SplinePrototype& p, bool loops, std::array<HermiteKey, kMaxPrototypeKeys>& out) {
+    const int n = p.count < 0 ? 0 : (p.count > kMaxPrototypeKeys ? kMaxPrototypeKeys : p.count);
+    for (int i = 0; i < n; ++i) {
+        const PrototypeKey& k = p.keys[static_cast<std::size_t>(i)];
+        out[static_cast<std::size_t>(i)] = {k.phase, vec3(k.x, k.y, k.z), vec3(0.0f)};
+    }
+    for (int i = 1; i + 1 < n; ++i) {
+        const HermiteKey& a = out[static_cast<std::size_t>(i - 1)];
+        const HermiteKey& b = out[static_cast<std::size_t>(i + 1)];
+        const float span = b.time - a.time;
+        if (span > 0.0f) out[static_cast<std::size_t>(i)].tangent = (b.position - a.position) / span;
+    }
+    if (loops && n >= 3) {
+        const HermiteKey& second = out[1];
+        const HermiteKey& before_last = out[static_cast<std::size_t>(n - 2)];
+        const float span = (second.time - out[0].time) + (out[static_cast<std::size_t>(n - 1)].time - before_last.time);
+        const vec3 t = span > 0.0f ? (second.position - before_last.position) / span : vec3(0.0f);
+        out[0].tangent = t;
+        out[static_cast<std::size_t>(n - 1)].tangent = t;
+    }
+    return n;
+}
+
+vec3 eval_keys(const std::array<HermiteKey, kMaxPrototypeKeys>& keys, int count, float phase) {
+    return sample_hermite(std::span<const HermiteKey>(keys.data(), static_cast<std::size_t>(count)), phase).position;
+}
+
+vec3 blended_swing(const GaitRig& rig, float blend, float u) {
+    return lerp(eval_keys(rig.walk.swing_foot, rig.walk.swing_count, u), eval_keys(rig.run.swing_foot, rig.run.swing_count, u), blend);
+}
+vec3 blended_pelvis(const GaitRig& rig, float blend, float phase) {
+    return lerp(eval_keys(rig.walk.pelvis, rig.walk.pelvis_count, phase), eval_keys(rig.run.pelvis, rig.run.pelvis_count, phase), blend);
+}
+// The hand path and its velocity (metres per cycle of phase).
+HermiteSample blended_hand(const GaitRig& rig, float blend, float phase) {
+    const HermiteSample walk = sample_hermite(std::span<const HermiteKey>(rig.walk.hand.data(), static_cast<std::size_t>(rig.walk.hand_count)), phase);
+    const HermiteSample run = sample_hermite(std::span<const HermiteKey>(rig.run.hand.data(), static_cast<std::size_t>(rig.run.hand_count)), phase);
+    return {lerp(walk.position, run.position, blend), lerp(walk.velocity, run.velocity, blend)};
+}
+
+// Sole points relative to the ankle, in the foot frame: under the ankle, the
+// ball of the foot (toe joint), the tip of the toes.
+std::array<vec3, 3> sole_offsets(const GaitRig& rig) {
+    return {vec3(0.0f, -rig.ankle_height, 0.0f), vec3(0.0f, -rig.ankle_height, rig.foot_length),
+            vec3(0.0f, -rig.ankle_height, rig.foot_length + rig.toe_length)};
+}
+
+struct Placement {
+    vec3 ankle;
+    quat rotation;
+    float ground;
+    float misfit;  // how far the sole had to rise to clear its toes, or a riser just ahead is above it
+};
+
+// A planted foot at (x, z): sole on the surface, aligned to the normal there and
+// to `forward`; raised just enough that no sole point is below the ground.
+Placement place_foot(const Terrain& terrain, const GaitRig& rig, float x, float z, vec3 forward) {
+    const GroundSample g = query_ground(terrain, x, z);
+    const vec3 n = g.normal;
+    const vec3 toes = normalize3(forward - n * dot3(forward, n), vec3(0.0f, 0.0f, 1.0f));
+    const vec3 side = cross3(n, toes);
+    const quat rotation = quat_from_axes(side, n, toes);
+    const vec3 ankle = vec3(x, g.height, z) + n * rig.ankle_height;
+    float lift = 0.0f;
+    for (const vec3& o : sole_offsets(rig)) {
+        const vec3 p = ankle + quat_rotate(rotation, o);
+        lift = maxf(lift, query_ground(terrain, p.x, p.z).height - p.y);
+    }
+    // A riser just ahead of the toes would be kicked at lift-off: count ground
+    // within 12 cm ahead rising more than 2 cm above the sole's plane as misfit.
+    float misfit = lift;
+    const float tip = rig.foot_length + rig.toe_length;
+    for (float ahead : {tip + 0.06f, tip + 0.12f}) {
+        const vec3 p = ankle + quat_rotate(rotation, vec3(0.0f, -rig.ankle_height, ahead)) + vec3(0.0f, lift, 0.0f);
+        misfit = maxf(misfit, query_ground(terrain, p.x, p.z).height - p.y - 0.02f);
+    }
+    // Nor may the heel hang against a riser behind it: the swing comes down past
+    // an edge one path key (a few cm) before it lands, so ground behind the
+    // ankle rising above the sole would be clipped on the way down.
+    for (float behind : {0.04f, 0.08f}) {
+        const vec3 p = ankle + quat_rotate(rotation, vec3(0.0f, -rig.ankle_height, -behind)) + vec3(0.0f, lift, 0.0f);
+        misfit = maxf(misfit, query_ground(terrain, p.x, p.z).height - p.y);
+    }
+    return {ankle + vec3(0.0f, lift, 0.0f), rotation, g.height + lift, misfit};
+}
+
+// The nearest spot along `forward` (within ±20 cm) where the whole sole rests
+// on one surface, so feet never land straddling a step edge.
+Placement place_foot_on_flat_spot(const Terrain& terrain, const GaitRig& rig, float x, float z, vec3 forward) {
+    Placement best = place_foot(terrain, rig, x, z, forward);
+    if (best.misfit < 0.004f) return best;
+    static constexpr float kOffsets[] = {-0.04f, 0.04f, -0.08f, 0.08f, -0.12f, 0.12f, -0.16f, 0.16f, -0.2f, 0.2f};
+    for (float d : kOffsets) {
+        const Placement p = place_foot(terrain, rig, x + forward.x * d, z + forward.z * d, forward);
+        if (p.misfit < 0.004f) return p;
+        if (p.misfit < best.misfit) best = p;
+    }
+    return best;
+}
+
+float step_duration(const GaitConfig& c, float speed) {
+    if (speed < 0.05f) return c.max_step_duration;
+    return clampf(c.step_length_multiplier / std::sqrt(speed), c.min_step_duration, c.max_step_duration);
+}
+
+bool running(const GaitConfig& c, float speed) { return speed > c.run_threshold; }
+float duty_for(const GaitConfig& c, float speed) { return running(c, speed) ? c.run_duty : c.walk_duty; }
+
+float foot_phase(float cycle_phase, int foot) { return frac(cycle_phase - (foot == 0 ? 0.0f : 0.5f)); }
+
+// The foot's rotation at step fraction s. It turns with the path, not with
+// time, so the toes point where the swing path's clearance floor looked for
+// them (build_swing_path); s already eases in and out over the swing (the
+// prototype's progress has zero tangents at both ends), so no further easing.
+quat swing_rotation(const FootState& f, float s) {
+    return quat_slerp(f.start_rotation, f.target_rotation, s);
+}
+
+// The swing path's Hermite keys from its heights: key i at s = i / (n − 1),
+// position (0, height, s · distance); vertical tangents are the harmonic mean of
+// the neighbouring slopes (zero at a peak, a valley and both ends), which keeps
+// each segment monotone: no overshoot above a key or dip below one.
+void swing_path_keys(const FootState& f, std::array<HermiteKey, kSwingPathKeys>& keys) {
+    constexpr int n = kSwingPathKeys;
+    const float spacing = 1.0f / static_cast<float>(n - 1);
+    const float distance = horizontal_distance(f.start, f.target);
+    for (int i = 0; i < n; ++i) {
+        const std::size_t k = static_cast<std::size_t>(i);
+        const float s = static_cast<float>(i) * spacing;
+        float slope = 0.0f;
+        if (i > 0 && i + 1 < n) {
+            const float before = (f.path_height[k] - f.path_height[k - 1]) / spacing;
+            const float after = (f.path_height[k + 1] - f.path_height[k]) / spacing;
+            if (before * after > 0.0f) slope = 2.0f * before * after / (before + after);
+        }
+        keys[k] = {s, vec3(0.0f, f.path_height[k], s * distance), vec3(0.0f, slope, distance)};
+    }
+}
+
+// The swing path (docs/gait.md): the ankle's height at evenly spaced fractions
+// s of the step's horizontal distance, as a monotone cubic Hermite spline in the
+// vertical plane of the step, (height, horizontal distance) against s.
+//
+// Each interior key is the higher of the prototype's shape there (the line from
+// lift-off to landing plus the blended lift) and the clearance floor: the highest
+// ground under the sole (ankle, ball, toe tip, for the toe directions of the
+// start, the target and halfway) at that key and both neighbours, plus the
+// ankle height and swing_clearance. Monotone tangents keep the curve between two
+// keys within their heights, so the sole clears every sampled ground between
+// them: the path rises before a step up and comes down only past a step edge.
+void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, const GaitConfig& c, float blend) {
+    constexpr int n = kSwingPathKeys;
+    // The toes at a key point between their directions at the neighbouring keys.
+    std::array<vec3, n> toe_direction{};
+    for (int i = 0; i < n; ++i)
+        toe_direction[static_cast<std::size_t>(i)] =
+            quat_rotate(swing_rotation(f, static_cast<float>(i) / static_cast<float>(n - 1)), vec3(0.0f, 0.0f, 1.0f));
+    std::array<float, n> ground{};
+    for (int i = 0; i < n; ++i) {
+        const float s = static_cast<float>(i) / static_cast<float>(n - 1);
+        const vec3 a = lerp(f.start, f.target, s);
+        float h = query_ground(terrain, a.x, a.z).height;
+        const vec3 toes[3] = {toe_direction[static_cast<std::size_t>(i > 0 ? i - 1 : 0)], toe_direction[static_cast<std::size_t>(i)],
+                              toe_direction[static_cast<std::size_t>(i + 1 < n ? i + 1 : n - 1)]};
+        for (const vec3& forward : toes)
+            for (float r : {rig.foot_length, rig.foot_length + rig.toe_length})
+                h = maxf(h, query_ground(terrain, a.x + forward.x * r, a.z + forward.z * r).height);
+        ground[static_cast<std::size_t>(i)] = h;
+    }
+    // The prototype's lift against the fraction of the step it has covered:
+    // (fraction, lift) sampled evenly in swing progress, fraction rising.
+    constexpr int m = 24;
+    std::array<float, m + 1> shape_fraction{}, shape_lift{};
+    for (int j = 0; j <= m; ++j) {
+        const vec3 shape = blended_swing(rig, blend, static_cast<float>(j) / static_cast<float>(m));
+        shape_fraction[static_cast<std::size_t>(j)] = clampf(shape.z, 0.0f, 1.0f);
+        shape_lift[static_cast<std::size_t>(j)] = shape.y;
+    }
+    int j = 0;
+    f.path_height[0] = f.start.y;
+    f.path_height[static_cast<std::size_t>(n - 1)] = f.target.y;
+    for (int i = 1; i + 1 < n; ++i) {
+        const float s = static_cast<float>(i) / static_cast<float>(n - 1);
+        while (j + 1 < m && shape_fraction[static_cast<std::size_t>(j + 1)] < s) ++j;
+        const float f0 = shape_fraction[static_cast<std::size_t>(j)], f1 = shape_fraction[static_cast<std::size_t>(j + 1)];
+        const float w = f1 > f0 ? clampf((s - f0) / (f1 - f0), 0.0f, 1.0f) : 1.0f;
+        const float lift = shape_lift[static_cast<std::size_t>(j)] + (shape_lift[static_cast<std::size_t>(j + 1)] - shape_lift[static_cast<std::size_t>(j)]) * w;
+        const float shaped = f.start.y + (f.target.y - f.start.y) * s + lift * f.lift_scale;
+        const std::size_t k = static_cast<std::size_t>(i);
+        const float floor = maxf(ground[k], maxf(ground[k - 1], ground[k + 1])) + rig.ankle_height + c.swing_clearance;
+        f.path_height[k] = maxf(shaped, floor);
+    }
+    std::array<HermiteKey, kSwingPathKeys> keys{};
+    swing_path_keys(f, keys);
+    f.path_length = build_arc_length_table(keys);
+}
+
+// Starts (or re-aims) a swing from where the foot is now toward a planted target.
+void begin_swing(FootState& f, const Placement& target, const Terrain& terrain, const GaitRig& rig, const GaitConfig& c,
+                 float blend, float lift_phase, float timed_rate) {
+    f.start = f.ankle;
+    f.start_rotation = f.rotation;
+    f.start_ground = f.ground;
+    f.target = target.ankle;
+    f.target_rotation = target.rotation;
+    f.target_ground = target.ground;
+    f.progress = 0.0f;
+    f.fraction = 0.0f;
+    f.lift_phase = lift_phase;
+    f.timed_rate = timed_rate;
+    const float distance = horizontal_distance(f.start, f.target);
+    f.lift_scale = clampf(distance / 0.3f, 0.35f, 1.0f);
+    f.swinging = 1;
+    build_swing_path(f, terrain, rig, c, blend);
+}
+
+// Where the swing puts the foot at progress u. The blended prototype's z says
+// what share of the path's length (arc length, climbing and descending
+// included) the foot has covered by then: the arc-length table turns that into
+// the step fraction s, so a foot stepping down a riser slows its horizontal
+// progress while it descends instead of dropping in a few ticks.
+void evaluate_swing(FootState& f, int foot, const GaitConfig& c, const GaitRig& rig, float blend, vec3 left) {
+    (void)c;
+    const float u = clampf(f.progress, 0.0f, 1.0f);
+    const vec3 shape = blended_swing(rig, blend, u);  // (sideways, lift, share of the path)
+    const float share = clampf(shape.z, 0.0f, 1.0f);
+    std::array<HermiteKey, kSwingPathKeys> keys{};
+    swing_path_keys(f, keys);
+    const std::span<const HermiteKey> path(keys.data(), keys.size());
+    const float total = f.path_length.total();
+    const float s = total > 1e-6f ? clampf(time_at_arc_length(path, f.path_length, share * total), 0.0f, 1.0f) : share;
+    f.fraction = s;
+    vec3 p = lerp(f.start, f.target, s) + left * (side_sign(foot) * shape.x * f.lift_scale);
+    p.y = sample_hermite(path, s).position.y;
+    f.ankle = p;
+    f.rotation = swing_rotation(f, s);
+    f.ground = f.start_ground + (f.target_ground - f.start_ground) * s;
+}
+
+void land(FootState& f, GaitState& g) {
+    f.ankle = f.target;
+    f.rotation = f.target_rotation;
+    f.ground = f.target_ground;
+    f.swinging = 0;
+    f.progress = 0.0f;
+    f.timed_rate = 0.0f;
+    f.replanned = 0;
+    ++g.steps;
+}
+
+struct StepPlan {
+    float duration;  // one step, s
+    float duty;
+};
+
+// The cadence follows the speed a quarter second ahead, so that while the
+// puppet speeds up its steps quicken before the root outruns the planted foot.
+StepPlan step_plan(const GaitConfig& c, float speed, float commanded, bool turning_in_place) {
+    if (turning_in_place) return {0.5f * (c.min_step_duration + c.max_step_duration), c.walk_duty};
+    const float ahead = maxf(speed, minf(commanded, speed + 0.25f * c.acceleration));
+    return {step_duration(c, ahead), duty_for(c, ahead)};
+}
+
+struct Landing {
+    float time;        // s until the swing foot lands
+    float distance;    // the root's travel until then
+    float end_speed;   // the speed then
+};
+// Runs the speed (approaching the command at the configured acceleration) and the
+// step clock (whose rate follows the speed) forward tick by tick until the foot's
+// phase completes: the same arithmetic as the tick, so the landing time and the
+// root's position then are what will really happen if the stick holds.
+Landing predict_landing(const GaitConfig& c, float speed, float commanded, float remaining_phase, bool turning, float dt) {
+    Landing out{0.0f, 0.0f, speed};
+    float phase_left = remaining_phase;
+    const float max_dv = c.acceleration * dt;
+    for (int k = 0; k < 1200 && phase_left > 0.0f; ++k) {
+        if (!turning) {
+            const float dv = commanded - out.end_speed;
+            out.end_speed += dv > max_dv ? max_dv : (dv < -max_dv ? -max_dv : dv);
+        }
+        out.distance += out.end_speed * dt;
+        phase_left -= dt / (2.0f * step_plan(c, out.end_speed, commanded, turning).duration);
+        out.time += dt;
+    }
+    return out;
+}
+
+// Where a swing starting now should land: ahead of the root's predicted position
+// at landing by half the distance it covers during the coming stance, beside the
+// heading at the hip's lateral offset, on a flat spot of the terrain.
+Placement plan_target(const GaitState& g, int foot, vec3 root, float heading, float desired_heading, const GaitConfig& c,
+                      const GaitRig& rig, const Terrain& terrain, float remaining_phase, float dt) {
+    const Landing predicted = predict_landing(c, g.speed, g.commanded_speed, remaining_phase, false, dt);
+    const float time_to_land = predicted.time;
+    const double turn = det::wrap_angle(static_cast<double>(desired_heading) - heading);
+    const double max_turn = c.turn_rate_deg_s * det::kDegToRad * time_to_land;
+    const double landing_heading = heading + (turn > max_turn ? max_turn : (turn < -max_turn ? -max_turn : turn));
+    const HeadingFrame now = heading_frame(heading);
+    const HeadingFrame then = heading_frame(landing_heading);
+    // Mean direction of travel over the swing.
+    const vec3 travel = normalize3(now.forward + then.forward, now.forward);
+    const vec3 root_then = root + travel * predicted.distance;
+    const StepPlan next = step_plan(c, predicted.end_speed, g.commanded_speed, false);
+    const float stance_time = next.duty * 2.0f * next.duration;
+    float ahead = predicted.end_speed * stance_time * 0.5f;
+    if (g.first_step) ahead *= 0.5f;
+    const vec3 spot = root_then + then.forward * ahead + then.left * (side_sign(foot) * rig.hip_half_width);
+    return place_foot_on_flat_spot(terrain, rig, spot.x, spot.z, then.forward);
+}
+
+constexpr float kShortestSwing = 0.12f;           // s: a late lift-off still swings this long
+constexpr float kWristDrag = 0.4f;                // hand tilt against its path's velocity, per m/cycle
+constexpr float kMaxTurnPerStepDeg = 90.0f;       // turning in place: most a foot turns in one swing
+constexpr float kMaxPelvisVerticalSpeed = 0.9f;   // m/s the pelvis follows its height target at, at most
+
+// Standing spot for a foot beside the other (planted) foot.
+Placement stop_target(const GaitState& g, int foot, float heading, const GaitRig& rig, const Terrain& terrain) {
+    const HeadingFrame h = heading_frame(heading);
+    const vec3 other = g.feet[static_cast<std::size_t>(1 - foot)].ankle;
+    const vec3 spot = other + h.left * (side_sign(foot) * 2.0f * rig.hip_half_width);
+    return place_foot_on_flat_spot(terrain, rig, spot.x, spot.z, h.forward);
+}
+
+}  // namespace
+
+float stick_speed_fraction(float deflection, const GaitConfig& c) {
+    if (deflection <= c.stick_deadzone) return 0.0f;
+    float d = (deflection - c.stick_deadzone) / (1.0f - c.stick_deadzone);
+    d = clampf(d, 0.0f, 1.0f);
+    return (1.0f - c.response_curve) * d + c.response_curve * d * d;
+}
+
+float slope_speed_multiplier(const Terrain& terrain, const GaitConfig& c, float x, float z, float heading) {
+    const vec3 n = query_ground(terrain, x, z).normal;
+    const HeadingFrame h = heading_frame(heading);
+    const float grade = n.y > 1e-3f ? -(n.x * h.forward.x + n.z * h.forward.z) / n.y : 0.0f;
+    if (grade == 0.0f) return 1.0f;  // level: what the formula gives, without the atan
+    const double degrees = det::atan(std::fabs(static_cast<double>(grade))) * det::kRadToDeg;
+    return clampf(1.0f - c.slope_speed_factor * static_cast<float>(degrees), 0.2f, 1.0f);
+}
+
+GaitRig make_gait_rig(const GaitConfig& c) {
+    GaitRig rig;
+    rig.walk.swing_count = build_prototype_keys(c.walk.swing_foot, false, rig.walk.swing_foot);
+    rig.walk.pelvis_count = build_prototype_keys(c.walk.pelvis, true, rig.walk.pelvis);
+    rig.walk.hand_count = build_prototype_keys(c.walk.hand, true, rig.walk.hand);
+    rig.run.swing_count = build_prototype_keys(c.run.swing_foot, false, rig.run.swing_foot);
+    rig.run.pelvis_count = build_prototype_keys(c.run.pelvis, true, rig.run.pelvis);
+    rig.run.hand_count = build_prototype_keys(c.run.hand, true, rig.run.hand);
+    rig.thigh = c.thigh_length;
+    rig.shin = c.shin_length;
+    rig.ankle_height = c.ankle_height;
+    rig.foot_length = c.foot_length;
+    rig.toe_length = c.toe_length;
+    rig.hip_half_width = 0.5f * c.hip_width;
+    rig.upper_arm = c.upper_arm_length;
+    rig.forearm = c.forearm_length;
+    // Inside the IK's exact zone (soft reach starts at 0.98), with a margin.
+    rig.leg_reach = 0.96f * (c.thigh_length + c.shin_length);
+    return rig;
+}
+
+GaitState initial_gait_state(const GaitConfig& c, const GaitRig& rig, const Terrain& terrain, vec3 root, float heading) {
+    GaitState g;
+    const HeadingFrame h = heading_frame(heading);
+    float ground_sum = 0.0f;
+    for (int i = 0; i < 2; ++i) {
+        const vec3 spot = root + h.left * (side_sign(i) * rig.hip_half_width);
+        const Placement p = place_foot(terrain, rig, spot.x, spot.z, h.forward);
+        FootState& f = g.feet[static_cast<std::size_t>(i)];
+        f.ankle = p.ankle;
+        f.rotation = p.rotation;
+        f.ground = p.ground;
+        ground_sum += p.ground;
+    }
+    g.pelvis_base = 0.5f * ground_sum;
+    g.pelvis = vec3(root.x, g.pelvis_base + c.gait_pelvis_height, root.z);
+    return g;
+}
+
+void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const GaitTickInput& in, const GaitConfig& c,
+                 const GaitRig& rig, const Terrain& terrain) {
+    const float dt = in.dt;
+    // Stick → commanded speed and direction (stick up walks toward −Z).
+    const float deflection = minf(1.0f, std::sqrt(in.stick_x * in.stick_x + in.stick_y * in.stick_y));
+    const float fraction = stick_speed_fraction(deflection, c);
+    const bool moving_command = fraction > 0.0f;
+    float desired_heading = heading;
+    if (moving_command) desired_heading = static_cast<float>(det::atan2(in.stick_x, -in.stick_y));
+    const double diff = det::wrap_angle(static_cast<double>(desired_heading) - heading);
+    const double abs_diff = diff < 0 ? -diff : diff;
+
+    if (moving_command) {
+        const std::int32_t was_turning = g.turning_in_place;
+        if (abs_diff > c.turn_in_place_deg * det::kDegToRad) g.turning_in_place = 1;
+        else if (abs_diff < 20.0 * det::kDegToRad) g.turning_in_place = 0;
+        // Swings aimed for turning in place re-aim for walking off, and back.
+        if (was_turning != g.turning_in_place)
+            for (FootState& f : g.feet) {
+                f.replanned = 0;
+                f.planned_speed = -1.0f;
+            }
+        const double max_turn = c.turn_rate_deg_s * det::kDegToRad * dt;
+        heading = static_cast<float>(det::wrap_angle(heading + (diff > max_turn ? max_turn : (diff < -max_turn ? -max_turn : diff))));
+        g.commanded_speed = c.max_speed * fraction * slope_speed_multiplier(terrain, c, root.x, root.z, heading);
+        if (g.turning_in_place) {
+            g.speed = 0.0f;  // immediate: no walking backwards
+        } else {
+            const float dv = g.commanded_speed - g.speed;
+            const float max_dv = c.acceleration * dt;
+            g.speed += dv > max_dv ? max_dv : (dv < -max_dv ? -max_dv : dv);
+        }
+    } else {
+        g.commanded_speed = 0.0f;
+        g.speed = 0.0f;  // stopping is immediate in movement
+        g.turning_in_place = 0;
+    }
+    const HeadingFrame h = heading_frame(heading);
+    velocity = vec2(h.forward.x * g.speed, h.forward.z * g.speed);
+    root.x += velocity.x * dt;
+    root.z += velocity.y * dt;
+
+    const bool wants_steps = moving_command && (g.speed > 0.0f || g.turning_in_place || abs_diff > 0.2);
+    const StepPlan plan = step_plan(c, g.speed, g.commanded_speed, g.turning_in_place != 0);
+    const float dphase = dt / (2.0f * plan.duration);
+
+    // Mode changes.
+    if (wants_steps && g.mode != GaitMode::stepping) {
+        if (g.mode == GaitMode::idle) {
+            // Lead with the foot on the side of the turn, else the left.
+            const int lead = diff < -0.2 ? 1 : 0;
+            g.cycle_phase = frac((lead == 0 ? 0.0f : 0.5f) + plan.duty);
+            g.first_step = 1;
+        }
+        g.mode = GaitMode::stepping;
+        for (FootState& f : g.feet) f.timed_rate = 0.0f;
+    } else if (!wants_steps && g.mode == GaitMode::stepping) {
+        g.mode = GaitMode::stopping;
+        // A foot in the air re-aims beside the planted one and lands quickly.
+        for (int i = 0; i < 2; ++i) {
+            FootState& f = g.feet[static_cast<std::size_t>(i)];
+            const FootState& other = g.feet[static_cast<std::size_t>(1 - i)];
+            if (!f.swinging) continue;
+            const float remaining = maxf(0.02f, (1.0f - f.progress) * (1.0f - f.lift_phase) * 2.0f * plan.duration);
+            // In a flight phase neither foot is down to stand beside: both go under their hips.
+            const vec3 spot = root + h.left * (side_sign(i) * rig.hip_half_width);
+            const Placement p = other.swinging ? place_foot_on_flat_spot(terrain, rig, spot.x, spot.z, h.forward)
+                                               : stop_target(g, i, heading, rig, terrain);
+            // Short, but never faster than 3 m/s for the foot.
+            const float time = clampf(maxf(remaining, horizontal_distance(f.ankle, p.ankle) / 3.0f), 0.15f, c.stop_transition_s);
+            begin_swing(f, p, terrain, rig, c, g.run_blend, 0.0f, 1.0f / time);
+        }
+    }
+
+    // Advance swings and lift stance feet.
+    const float blend_target = clampf((g.speed - c.run_threshold) / 0.6f + 0.5f, 0.0f, 1.0f);
+    g.run_blend = approach(g.run_blend, blend_target, c.interpolation_rate, dt);
+    if (g.mode == GaitMode::stepping) g.cycle_phase = frac(g.cycle_phase + dphase);
+    // Where foot i, lifting (or re-aiming) at its phase psi, should land.
+    const auto aim = [&](int i, float psi) {
+        if (!g.turning_in_place) return plan_target(g, i, root, heading, desired_heading, c, rig, terrain, 1.0f - psi, dt);
+        // Turning in place: small steps to the hip's spot under the turned heading.
+        const float time_to_land = predict_landing(c, g.speed, g.commanded_speed, 1.0f - psi, true, dt).time;
+        const double turn = det::wrap_angle(static_cast<double>(desired_heading) - heading);
+        // Small steps: a foot turns at most kMaxTurnPerStep per swing.
+        const double max_turn = minf(c.turn_rate_deg_s * time_to_land, kMaxTurnPerStepDeg) * det::kDegToRad;
+        const HeadingFrame then = heading_frame(heading + (turn > max_turn ? max_turn : (turn < -max_turn ? -max_turn : turn)));
+        const vec3 spot = root + then.left * (side_sign(i) * rig.hip_half_width);
+        return place_foot_on_flat_spot(terrain, rig, spot.x, spot.z, then.forward);
+    };
+    for (int i = 0; i < 2; ++i) {
+        FootState& f = g.feet[static_cast<std::size_t>(i)];
+        FootState& other = g.feet[static_cast<std::size_t>(1 - i)];
+        if (f.swinging) {
+            const float rate = f.timed_rate > 0.0f ? f.timed_rate * dt
+                                                   : minf(dphase / maxf(1e-3f, 1.0f - f.lift_phase), dt / kShortestSwing);
+            f.progress += rate;
+            if (f.progress >= 1.0f) {
+                land(f, g);
+                g.first_step = 0;
+            } else {
+                // Re-aim once if the stick changed the landing spot a lot.
+                const bool command_changed = std::fabs(g.commanded_speed - f.planned_speed) > 0.25f ||
+                                             std::fabs(det::wrap_angle(static_cast<double>(desired_heading) - f.planned_heading)) > 0.25;
+                if (g.mode == GaitMode::stepping && command_changed && !f.replanned && f.timed_rate == 0.0f && f.progress < 0.6f) {
+                    const float psi = foot_phase(g.cycle_phase, i);
+                    const Placement p = aim(i, psi);
+                    if (horizontal_distance(p.ankle, f.target) > 0.06f) {
+                        const float ground = f.ground;
+                        begin_swing(f, p, terrain, rig, c, g.run_blend, psi, 0.0f);
+                        f.start_ground = ground;
+                        f.replanned = 1;
+                    }
+                    f.planned_speed = g.commanded_speed;
+                    f.planned_heading = desired_heading;
+                }
+                evaluate_swing(f, i, c, rig, g.run_blend, h.left);
+            }
+        } else if (g.mode == GaitMode::stepping) {
+            const float psi = foot_phase(g.cycle_phase, i);
+            const bool walking = !running(c, g.speed);
+            if (psi >= plan.duty && (!walking || !other.swinging)) {
+                begin_swing(f, aim(i, psi), terrain, rig, c, g.run_blend, psi, 0.0f);
+                f.planned_speed = g.commanded_speed;
+                f.planned_heading = desired_heading;
+                evaluate_swing(f, i, c, rig, g.run_blend, h.left);
+            }
+        }
+    }
+    if (g.mode == GaitMode::stopping && !g.feet[0].swinging && !g.feet[1].swinging) {
+        // Both down: bring the trailing foot beside the other in one step, or rest.
+        const float along = dot3(g.feet[0].ankle - g.feet[1].ankle, h.forward);
+        if (std::fabs(along) > 0.05f) {
+            const int trailing = along < 0.0f ? 0 : 1;
+            const Placement p = stop_target(g, trailing, heading, rig, terrain);
+            begin_swing(g.feet[static_cast<std::size_t>(trailing)], p, terrain, rig, c, g.run_blend, 0.0f, 1.0f / maxf(0.25f, c.stop_transition_s * 1.5f));
+            evaluate_swing(g.feet[static_cast<std::size_t>(trailing)], trailing, c, rig, g.run_blend, h.left);
+        } else {
+            g.mode = GaitMode::idle;
+        }
+    }
+    const bool flight = g.feet[0].swinging && g.feet[1].swinging;
+    if (flight && !g.flight_phases_open) ++g.flight_phases;
+    g.flight_phases_open = flight ? 1 : 0;
+
+    // Pelvis: over the root, at the mean foot height plus the configured height,
+    // with the prototype's bob and sway, breathing when still; then lowered where
+    // needed so both ankles stay within the IK's exact reach.
+    g.activity = approach(g.activity, g.mode == GaitMode::idle ? 0.0f : clampf(g.speed / 1.0f, 0.0f, 1.0f), c.interpolation_rate, dt);
+    if (g.mode == GaitMode::idle) {
+        // Settle over the middle of the feet.
+        const vec3 mid = 0.5f * (g.feet[0].ankle + g.feet[1].ankle);
+        root.x = approach(root.x, mid.x, c.interpolation_rate, dt);
+        root.z = approach(root.z, mid.z, c.interpolation_rate, dt);
+    }
+    const float ground_mean = 0.5f * (g.feet[0].ground + g.feet[1].ground);
+    g.pelvis_base = approach(g.pelvis_base, ground_mean, c.interpolation_rate * 1.5f, dt);
+    root.y = g.pelvis_base;
+    const float step_phase = frac(2.0f * g.cycle_phase);
+    const vec3 bob = blended_pelvis(rig, g.run_blend, step_phase) * g.activity;
+    const float stance_side = g.cycle_phase < 0.5f ? 1.0f : -1.0f;  // left foot leads the first half
+    const double breath = det::sin(det::kTwoPi * in.breath_time / c.breath_period_s);
+    vec3 pelvis = root + h.left * (bob.x * stance_side) + h.forward * bob.z;
+    pelvis.y = g.pelvis_base + c.gait_pelvis_height + bob.y + static_cast<float>(breath) * c.breath_amplitude * (1.0f - g.activity);
+    // Planted feet bind exactly (within the IK's exact zone). A swinging foot
+    // binds where it will land, seen from where its hip will be then, and the
+    // pelvis moves toward that height at a bounded vertical speed, so stepping
+    // down lowers it over the swing instead of in the last few ticks; the swing
+    // foot now only has to stay within the full leg (the IK's soft reach).
+    const float reach2 = rig.leg_reach * rig.leg_reach;
+    const float full_reach = 0.995f * (rig.thigh + rig.shin);
+    const auto drop_for = [](float horizontal2, float r2) { return std::sqrt(maxf(r2 - horizontal2, 0.09f * r2)); };
+    float hard_limit = 1e9f;
+    float soft_limit = 1e9f;
+    for (int i = 0; i < 2; ++i) {
+        const FootState& f = g.feet[static_cast<std::size_t>(i)];
+        const vec3 hip = pelvis + h.left * (side_sign(i) * rig.hip_half_width);
+        const float dx = f.ankle.x - hip.x, dz = f.ankle.z - hip.z;
+        if (!f.swinging) {
+            hard_limit = minf(hard_limit, f.ankle.y + drop_for(dx * dx + dz * dz, reach2));
+            continue;
+        }
+        // The planted reach at lift-off and landing, the full leg mid-swing, so
+        // neither lifting nor landing changes the limit in one tick.
+        const float u = clampf(f.progress, 0.0f, 1.0f);
+        const float swing_reach = rig.leg_reach + (full_reach - rig.leg_reach) * (4.0f * u * (1.0f - u));
+        hard_limit = minf(hard_limit, f.ankle.y + drop_for(dx * dx + dz * dz, swing_reach * swing_reach));
+        const float rate = f.timed_rate > 0.0f ? f.timed_rate
+                                               : minf(dphase / dt / maxf(1e-3f, 1.0f - f.lift_phase), 1.0f / kShortestSwing);
+        const float remaining = maxf(0.0f, 1.0f - f.progress) / rate;
+        const vec3 hip_then = hip + h.forward * (g.speed * remaining);
+        const float tx = f.target.x - hip_then.x, tz = f.target.z - hip_then.z;
+        soft_limit = minf(soft_limit, f.target.y + drop_for(tx * tx + tz * tz, reach2));
+    }
+    const float previous_y = g.pelvis.y;
+    const float max_move = kMaxPelvisVerticalSpeed * dt;
+    pelvis.y = minf(pelvis.y, soft_limit);
+    pelvis.y = clampf(pelvis.y, previous_y - max_move, previous_y + max_move);
+    pelvis.y = minf(pelvis.y, hard_limit);
+    g.pelvis = pelvis;
+    const float lean_target = minf(c.max_spine_lean_deg, c.spine_lean_deg_per_m_s * g.speed) * static_cast<float>(det::kDegToRad);
+    g.lean = approach(g.lean, lean_target, c.interpolation_rate, dt);
+}
+
+bool GaitPoseJob::validate() const {
+    const std::size_t n = static_cast<std::size_t>(kPuppetJointCount);
+    return gait && rig && config && parents.size() == n && rest_offsets.size() == n && local_rotations.size() == n &&
+           local_translations.size() == n && model_rotations.size() >= n && model_positions.size() >= n;
+}
+
+void GaitPoseJob::run() const {
+    const GaitState& g = *gait;
+    const GaitRig& r = *rig;
+    const GaitConfig& c = *config;
+    for (std::size_t j = 0; j < local_rotations.size(); ++j) {
+        local_rotations[j] = quat_identity();
+        local_translations[j] = rest_offsets[j];
+    }
+    const HeadingFrame h = heading_frame(heading);
+    const quat yaw = quat_axis_angle(vec3(0.0f, 1.0f, 0.0f), heading);
+    local_rotations[kPelvis] = yaw;
+    local_translations[kPelvis] = g.pelvis;
+    // Spine leans into the motion (spread over three joints), breathes when still;
+    // neck and head take back half the lean so the gaze stays level.
+    const double breath = det::sin(det::kTwoPi * breath_time / c.breath_period_s) * (1.0f - g.activity);
+    const quat spine = quat_axis_angle(vec3(1.0f, 0.0f, 0.0f), g.lean / 3.0f - 0.01 * breath);
+    local_rotations[kSpine1] = spine;
+    local_rotations[kSpine2] = spine;
+    local_rotations[kSpine3] = spine;
+    const quat head = quat_axis_angle(vec3(1.0f, 0.0f, 0.0f), -0.25 * g.lean + 0.01 * breath);
+    local_rotations[kNeck] = head;
+    local_rotations[kHead] = head;
+
+    // Legs: two-bone IK from each hip to its ankle, knees forward.
+    const int thighs[2] = {kThighL, kThighR};
+    for (int i = 0; i < 2; ++i) {
+        const FootState& f = g.feet[static_cast<std::size_t>(i)];
+        TwoBoneIkInput ik;
+        ik.root = g.pelvis + h.left * (side_sign(i) * r.hip_half_width);
+        ik.target = f.ankle;
+        ik.pole = h.forward;
+        ik.upper_length = r.thigh;
+        ik.lower_length = r.shin;
+        const TwoBoneIkResult s = solve_two_bone_ik(ik);
+        const std::size_t thigh = static_cast<std::size_t>(thighs[i]);
+        local_rotations[thigh] = quat_normalize(quat_mul(quat_conjugate(yaw), s.upper_rotation));
+        local_rotations[thigh + 1] = quat_normalize(quat_mul(quat_conjugate(s.upper_rotation), s.lower_rotation));
+        local_rotations[thigh + 2] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), f.rotation));
+    }
+    LocalToModelJob fk{parents, local_rotations, local_translations, model_rotations, model_positions};
+    fk.run();
+
+    // Arms: the hands follow the blended hand paths, swinging against the legs;
+    // elbows point back.
+    const int clavicles[2] = {kClavicleL, kClavicleR};
+    const float hang = 0.95f * (r.upper_arm + r.forearm);
+    for (int i = 0; i < 2; ++i) {
+        const std::size_t clavicle = static_cast<std::size_t>(clavicles[i]);
+        const vec3 shoulder = model_positions[clavicle + 1];
+        const HermiteSample hand = blended_hand(r, g.run_blend, foot_phase(g.cycle_phase, i));
+        const vec3 rest(0.03f, 0.0f, 0.02f);
+        const vec3 offset = lerp(rest, hand.position, g.activity);
+        TwoBoneIkInput ik;
+        ik.root = shoulder;
+        ik.target = shoulder + h.left * (side_sign(i) * offset.x) + vec3(0.0f, offset.y - hang, 0.0f) + h.forward * offset.z;
+        ik.pole = -h.forward + h.left * (side_sign(i) * 0.3f);
+        ik.upper_length = r.upper_arm;
+        ik.lower_length = r.forearm;
+        ik.hinge_sign = -1.0f;
+        const TwoBoneIkResult s = solve_two_bone_ik(ik);
+        const quat clavicle_rotation = model_rotations[clavicle];
+        local_rotations[clavicle + 1] = quat_normalize(quat_mul(quat_conjugate(clavicle_rotation), s.upper_rotation));
+        local_rotations[clavicle + 2] = quat_normalize(quat_mul(quat_conjugate(s.upper_rotation), s.lower_rotation));
+        // The wrist follows the hand path's swing direction: the hand trails the
+        // motion (follow-through), tilting against the path's velocity along the
+        // heading and sideways, by kWristDrag per metre per cycle; at rest it
+        // continues the forearm. quat_from_to: half-angle identity, no trig.
+        const vec3 forearm_down = quat_rotate(s.lower_rotation, vec3(0.0f, -1.0f, 0.0f));
+        const vec3 v = hand.velocity * g.activity;
+        const vec3 drag = h.forward * (-kWristDrag * v.z) + h.left * (-kWristDrag * side_sign(i) * v.x);
+        const vec3 hand_down = normalize3(forearm_down + drag, forearm_down);
+        const quat hand_rotation = quat_mul(quat_from_to(forearm_down, hand_down), s.lower_rotation);
+        local_rotations[clavicle + 3] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), hand_rotation));
+    }
+    // Only the arms changed since the full pass (hands are leaves; nothing after
+    // them hangs off an arm): redo forward kinematics for those six joints, with
+    // LocalToModelJob's arithmetic, so the result is the same bits as a full pass.
+    for (int clavicle : {kClavicleL, kClavicleR})
+        for (int j = clavicle + 1; j <= clavicle + 3; ++j) {
+            const std::size_t k = static_cast<std::size_t>(j);
+            const std::size_t p = static_cast<std::size_t>(parents[k]);
+            const quat parent_rotation = model_rotations[p];
+            model_rotations[k] = quat_mul(parent_rotation, local_rotations[k]);
+            model_positions[k] = model_positions[p] + quat_rotate(parent_rotation, local_translations[k]);
+        }
+}
+
+}  // namespace marionette

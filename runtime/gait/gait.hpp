@@ -1,0 +1,128 @@
+#pragma once
+// The spline-IK gait (docs/gait.md): stick → velocity, step planning on the
+// terrain, swing paths fitted from blended walk/run Hermite prototypes, stance
+// feet pinned, pelvis from the feet, two-bone IK for legs and arms.
+//
+// Two jobs, so the pose source can be swapped (the motion graph will offer
+// procedural gait / motion graph / graph + procedural foot placement):
+//   update_gait()  advances the plan: GaitState(k) + input → GaitState(k+1)
+//   pose_from_gait() turns a GaitState into local and model joint transforms.
+// Both are pure functions of their arguments and never allocate.
+#include <array>
+#include <cstdint>
+#include <span>
+
+#include "runtime/math/hermite_spline.hpp"
+#include "runtime/gait/gait_config.hpp"
+#include "runtime/ground/terrain.hpp"
+
+namespace marionette {
+
+inline constexpr int kSwingPathKeys = 20;
+
+enum class GaitMode : std::int32_t { idle = 0, stepping = 1, stopping = 2 };
+
+struct FootState {
+    vec3 ankle{0.0f};                         // where the ankle is now (IK target), world
+    quat rotation{1.0f, 0.0f, 0.0f, 0.0f};    // foot frame now: +Y sole normal, +Z toes
+    float ground = 0.0f;                      // ground height the foot stands on / is heading for
+    std::int32_t swinging = 0;                // 0 stance (pinned), 1 swing
+    // The current swing (meaningful while swinging).
+    vec3 start{0.0f};
+    quat start_rotation{1.0f, 0.0f, 0.0f, 0.0f};
+    float start_ground = 0.0f;
+    vec3 target{0.0f};
+    quat target_rotation{1.0f, 0.0f, 0.0f, 0.0f};
+    float target_ground = 0.0f;
+    float progress = 0.0f;                    // 0 → 1 over the swing
+    float fraction = 0.0f;                    // of the step's horizontal distance covered
+    float lift_phase = 0.0f;                  // the foot's cycle phase at lift-off (progress 0)
+    float timed_rate = 0.0f;                  // > 0: progress per second (stop transition), else phase-driven
+    float lift_scale = 1.0f;                  // small steps lift less
+    std::int32_t replanned = 0;               // a swing re-aims at most once
+    float planned_speed = 0.0f;               // the command the target was planned for
+    float planned_heading = 0.0f;
+    // The swing path: ankle height at evenly spaced fractions of the step, clear
+    // of the ground under the sole (steps up, box edges), and its arc-length
+    // table (the foot's progress along it is by length: docs/gait.md).
+    std::array<float, kSwingPathKeys> path_height{};
+    ArcLengthTable path_length{};
+};
+
+struct GaitState {
+    std::array<FootState, 2> feet{};          // 0 left, 1 right
+    GaitMode mode = GaitMode::idle;
+    float cycle_phase = 0.0f;                 // [0, 1): left contact at 0, right at 0.5
+    float speed = 0.0f;                       // along the heading, m/s
+    float commanded_speed = 0.0f;             // from the stick, after the slope factor
+    float run_blend = 0.0f;                   // 0 walk … 1 run prototypes (follows speed)
+    float pelvis_base = 0.0f;                 // smoothed mean ground height under the feet
+    vec3 pelvis{0.0f};                        // pelvis joint, world
+    float lean = 0.0f;                        // spine lean, radians (follows speed)
+    float activity = 0.0f;                    // 0 standing … 1 moving: scales bob and arm swing
+    std::int32_t turning_in_place = 0;
+    std::int32_t first_step = 0;              // the step from standstill is half length
+    std::int32_t steps = 0;                   // landings so far
+    std::int32_t flight_phases = 0;           // times both feet left the ground
+    std::int32_t flight_phases_open = 0;      // both feet are off the ground now
+};
+
+// Everything the gait needs from the configuration and skeleton, prepared once:
+// prototype splines as Hermite keys, bone lengths, offsets.
+struct GaitRig {
+    struct PrototypeSplines {
+        std::array<HermiteKey, kMaxPrototypeKeys> swing_foot{};
+        std::array<HermiteKey, kMaxPrototypeKeys> pelvis{};
+        std::array<HermiteKey, kMaxPrototypeKeys> hand{};
+        int swing_count = 0, pelvis_count = 0, hand_count = 0;
+    };
+    PrototypeSplines walk;
+    PrototypeSplines run;
+    float thigh = 0.0f, shin = 0.0f, ankle_height = 0.0f, foot_length = 0.0f, toe_length = 0.0f;
+    float hip_half_width = 0.0f, upper_arm = 0.0f, forearm = 0.0f;
+    float leg_reach = 0.0f;                   // hip–ankle distance the pelvis keeps within (exact IK zone)
+};
+
+GaitRig make_gait_rig(const GaitConfig& config);
+
+// The standing start: feet planted side by side under the hips at `root`.
+GaitState initial_gait_state(const GaitConfig& config, const GaitRig& rig, const Terrain& terrain, vec3 root, float heading);
+
+// Stick deflection (0..1) → speed fraction: radial deadzone, then response curve.
+float stick_speed_fraction(float deflection, const GaitConfig& config);
+
+// Degrees of slope along `heading` at (x, z) and the speed factor it gives.
+float slope_speed_multiplier(const Terrain& terrain, const GaitConfig& config, float x, float z, float heading);
+
+struct GaitTickInput {
+    float stick_x = 0.0f;   // [-1, 1], right
+    float stick_y = 0.0f;   // [-1, 1], up (moves toward −Z)
+    float dt = 0.0f;
+    float breath_time = 0.0f;  // seconds, drives the idle breathing
+};
+
+// Advances the gait one tick. root_position and heading are the puppet's (the
+// ground point under the pelvis, and the facing angle) and are updated too.
+void update_gait(GaitState& gait, vec3& root_position, float& heading, vec2& velocity, const GaitTickInput& input,
+                 const GaitConfig& config, const GaitRig& rig, const Terrain& terrain);
+
+// The seam: the pose for a gait state. Writes local transforms for the 22-joint
+// puppet and runs forward kinematics into the model spans (sizes = joint count).
+struct GaitPoseJob {
+    const GaitState* gait = nullptr;
+    const GaitRig* rig = nullptr;
+    const GaitConfig* config = nullptr;
+    float heading = 0.0f;
+    float breath_time = 0.0f;              // seconds, drives idle breathing
+    std::span<const int> parents;
+    std::span<const vec3> rest_offsets;
+    std::span<quat> local_rotations;
+    std::span<vec3> local_translations;
+    std::span<quat> model_rotations;
+    std::span<vec3> model_positions;
+
+    bool validate() const;
+    void run() const;
+};
+
+}  // namespace marionette

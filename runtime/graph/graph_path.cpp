@@ -1,0 +1,267 @@
+#include "runtime/graph/graph_path.hpp"
+
+#include <algorithm>
+#include <limits>
+
+namespace marionette {
+
+GraphLocation locate_frame(const MotionGraph& g, int clip, int frame) {
+    GraphLocation best;
+    for (const GraphEdge& e : g.edges) {
+        if (e.kind != GraphEdgeKind::clip) continue;
+        const GraphNode& a = g.nodes[static_cast<size_t>(e.from)];
+        const GraphNode& b = g.nodes[static_cast<size_t>(e.to)];
+        if (a.clip == clip && a.frame <= frame && frame < b.frame) return {e.from, frame - a.frame};
+        if (b.clip == clip && b.frame == frame) best = {e.to, 0};
+    }
+    return best;
+}
+
+double edge_cost(const MotionGraph& g, const GraphEdge& e, double transition_weight) {
+    return transition_weight * e.cost + e.frames / g.frame_rate;
+}
+
+GraphPathSearch::GraphPathSearch(const MotionGraph& g, double transition_weight)
+    : graph_(g), transition_weight_(transition_weight) {
+    const size_t n = g.nodes.size();
+    distance_.resize(n);
+    via_edge_.resize(n);
+    stamp_.assign(n, 0);
+    goal_extra_.assign(n, -1.0);
+    goal_after_.assign(n, 0);
+    heap_.reserve(g.edges.size() + n + 1);
+    path_.resize(n);
+}
+
+void GraphPathSearch::clear_goals() {
+    goal_labels_ = 0;
+    if (!frame_goals_) return;
+    std::fill(goal_extra_.begin(), goal_extra_.end(), -1.0);
+    std::fill(goal_after_.begin(), goal_after_.end(), 0);
+    frame_goals_ = false;
+}
+
+void GraphPathSearch::add_label_goal(int label) {
+    if (label < 0 || label >= kMaxGraphLabels) return;
+    goal_labels_ |= 1u << label;
+}
+
+bool GraphPathSearch::add_frame_goal(int clip, int frame) {
+    const GraphLocation at = locate_frame(graph_, clip, frame);
+    if (at.node < 0) return false;
+    goal_extra_[static_cast<size_t>(at.node)] = at.frames_after / graph_.frame_rate;
+    goal_after_[static_cast<size_t>(at.node)] = at.frames_after;
+    frame_goals_ = true;
+    return true;
+}
+
+double GraphPathSearch::distance(size_t node) const {
+    return stamp_[node] == generation_ ? distance_[node] : std::numeric_limits<double>::infinity();
+}
+
+// A label goal costs nothing more on arrival; a frame goal adds the frames still
+// to play after its node. −1: not a goal.
+double GraphPathSearch::goal_extra(size_t node) const {
+    const double frame_extra = goal_extra_[node];
+    const bool labelled = (graph_.clips[static_cast<size_t>(graph_.nodes[node].clip)].label_mask & goal_labels_) != 0;
+    return labelled ? 0.0 : frame_extra;
+}
+
+bool GraphPathSearch::run(int start) {
+    begin(start);
+    return advance(std::numeric_limits<std::int64_t>::max()) == PathSearchStatus::found;
+}
+
+void GraphPathSearch::begin(int start) {
+    if (++generation_ == 0) {  // wrapped: old stamps could alias the new generation
+        std::fill(stamp_.begin(), stamp_.end(), 0u);
+        generation_ = 1;
+    }
+    heap_.clear();
+    path_length_ = 0;
+    goal_node_ = -1;
+    goal_frames_after_ = 0;
+    cost_ = 0.0;
+    best_ = std::numeric_limits<double>::infinity();
+    settled_ = 0;
+    pops_ = 0;
+    start_ = start;
+    if (start < 0 || static_cast<size_t>(start) >= graph_.nodes.size()) {
+        status_ = PathSearchStatus::unreachable;
+        return;
+    }
+    const size_t s = static_cast<size_t>(start);
+    stamp_[s] = generation_;
+    distance_[s] = 0.0;
+    via_edge_[s] = -1;
+    heap_.push_back({0.0, start});
+    status_ = PathSearchStatus::running;
+}
+
+PathSearchStatus GraphPathSearch::advance(std::int64_t max_pops) {
+    // Min-heap on (cost, node): ties resolve by node index, so results are deterministic.
+    const auto later = [](const std::pair<double, std::int32_t>& a, const std::pair<double, std::int32_t>& b) {
+        return a.first != b.first ? a.first > b.first : a.second > b.second;
+    };
+    const std::int64_t limit =
+        max_pops >= std::numeric_limits<std::int64_t>::max() - pops_ ? std::numeric_limits<std::int64_t>::max() : pops_ + max_pops;
+    // The end is checked before the budget, so where the query stands after k pops
+    // does not depend on how the pops were sliced.
+    while (status_ == PathSearchStatus::running) {
+        if (heap_.empty()) {
+            finish();
+            break;
+        }
+        if (pops_ >= limit) break;
+        std::pop_heap(heap_.begin(), heap_.end(), later);
+        const auto [d, v] = heap_.back();
+        heap_.pop_back();
+        ++pops_;
+        // Every later node costs at least d, so once d reaches the best goal we are done.
+        if (d >= best_) {
+            finish();
+            break;
+        }
+        if (d > distance(static_cast<size_t>(v))) continue;
+        ++settled_;
+        const double extra = goal_extra(static_cast<size_t>(v));
+        if (extra >= 0.0 && d + extra < best_) {
+            best_ = d + extra;
+            goal_node_ = v;
+        }
+        for (const GraphEdge& e : graph_.out_edges(v)) {
+            const double nd = d + edge_cost(graph_, e, transition_weight_);
+            const size_t w = static_cast<size_t>(e.to);
+            // Lazy deletion pushes at most one entry per edge relaxation: the
+            // capacity reserved (edges + nodes + 1) is never exceeded.
+            if (nd < distance(w) && heap_.size() < heap_.capacity()) {
+                stamp_[w] = generation_;
+                distance_[w] = nd;
+                via_edge_[w] = graph_.edge_index(e);
+                heap_.push_back({nd, static_cast<std::int32_t>(w)});
+                std::push_heap(heap_.begin(), heap_.end(), later);
+            }
+        }
+    }
+    return status_;
+}
+
+void GraphPathSearch::finish() {
+    heap_.clear();
+    if (goal_node_ < 0) {
+        status_ = PathSearchStatus::unreachable;
+        return;
+    }
+    status_ = PathSearchStatus::found;
+    cost_ = best_;
+    goal_frames_after_ = goal_after_[static_cast<size_t>(goal_node_)];
+    std::int32_t v = goal_node_;
+    size_t count = 0;
+    while (v != start_ && count < path_.size()) {
+        const std::int32_t e = via_edge_[static_cast<size_t>(v)];
+        path_[count++] = e;
+        v = graph_.edges[static_cast<size_t>(e)].from;
+    }
+    std::reverse(path_.begin(), path_.begin() + static_cast<std::ptrdiff_t>(count));
+    path_length_ = count;
+}
+
+float transition_weight(int p, int k) {
+    const double t = static_cast<double>(p + 1) / k;
+    return static_cast<float>(2.0 * t * t * t - 3.0 * t * t + 1.0);
+}
+
+PlanarTransform edge_alignment(const GraphEdge& e) { return {e.align_angle, e.align_dx, e.align_dz}; }
+
+void graph_frame_pose(const MotionGraph& g, int global_frame, const PlanarTransform& world, std::span<quat> rotations,
+                      std::span<vec3> translations) {
+    const size_t joints = static_cast<size_t>(g.joint_count());
+    const size_t base = static_cast<size_t>(global_frame) * joints;
+    const quat yaw = planar_rotation(world);
+    for (size_t j = 0; j < joints; ++j) {
+        rotations[j] = g.rotations[base + j];
+        translations[j] = g.translations[base + j];
+        if (g.skeleton.parents[j] == kNoParent) {
+            rotations[j] = quat_normalize(quat_mul(yaw, rotations[j]));
+            translations[j] = apply_planar(world, translations[j]);
+        }
+    }
+}
+
+std::uint8_t graph_transition_pose(const MotionGraph& g, const GraphEdge& e, int p, const PlanarTransform& world,
+                                   std::span<quat> rotations, std::span<vec3> translations) {
+    const GraphNode& a = g.nodes[static_cast<size_t>(e.from)];
+    const GraphNode& b = g.nodes[static_cast<size_t>(e.to)];
+    const int fa = g.clips[static_cast<size_t>(a.clip)].first_frame + a.frame + p;
+    const int fb = g.clips[static_cast<size_t>(b.clip)].first_frame + b.frame - g.window_frames + p;
+    const PlanarTransform world_b = compose_planar(world, edge_alignment(e));
+    const float alpha = transition_weight(p, g.window_frames);
+    const size_t joints = static_cast<size_t>(g.joint_count());
+    const size_t base_a = static_cast<size_t>(fa) * joints, base_b = static_cast<size_t>(fb) * joints;
+    const quat yaw_a = planar_rotation(world), yaw_b = planar_rotation(world_b);
+    for (size_t j = 0; j < joints; ++j) {
+        quat qa = g.rotations[base_a + j], qb = g.rotations[base_b + j];
+        vec3 ta = g.translations[base_a + j], tb = g.translations[base_b + j];
+        if (g.skeleton.parents[j] == kNoParent) {
+            qa = quat_mul(yaw_a, qa);
+            qb = quat_mul(yaw_b, qb);
+            ta = apply_planar(world, ta);
+            tb = apply_planar(world_b, tb);
+        }
+        rotations[j] = quat_slerp(qa, qb, 1.0f - alpha);
+        translations[j] = lerp(ta, tb, 1.0f - alpha);
+    }
+    return alpha >= 0.5f ? g.contacts[static_cast<size_t>(fa)] : g.contacts[static_cast<size_t>(fb)];
+}
+
+Clip synthesize_path(const MotionGraph& g, int start_clip, int start_frame, std::span<const std::int32_t> edges,
+                     int frames_after) {
+    Clip out;
+    out.name = "graph_path";
+    out.skeleton = g.skeleton;
+    out.animated_translation = g.animated_translation;
+    out.length_unit = g.length_unit;
+    out.frame_rate = g.frame_rate;
+    const size_t joints = static_cast<size_t>(g.joint_count());
+    std::vector<quat> r(joints);
+    std::vector<vec3> t(joints);
+    const auto emit = [&] {
+        out.rotations.insert(out.rotations.end(), r.begin(), r.end());
+        out.translations.insert(out.translations.end(), t.begin(), t.end());
+        ++out.frame_count;
+    };
+    PlanarTransform world;
+    int clip = start_clip, frame = start_frame;
+    for (const std::int32_t ei : edges) {
+        const GraphEdge& e = g.edges[static_cast<size_t>(ei)];
+        const GraphNode& from = g.nodes[static_cast<size_t>(e.from)];
+        // Frames of the current clip up to the edge's start (only before the first edge).
+        for (; clip == from.clip && frame < from.frame; ++frame) {
+            graph_frame_pose(g, g.clips[static_cast<size_t>(clip)].first_frame + frame, world, r, t);
+            emit();
+        }
+        if (e.kind == GraphEdgeKind::clip) {
+            for (int f = from.frame; f < from.frame + e.frames; ++f) {
+                graph_frame_pose(g, g.clips[static_cast<size_t>(from.clip)].first_frame + f, world, r, t);
+                emit();
+            }
+        } else {
+            for (int p = 0; p < e.frames; ++p) {
+                graph_transition_pose(g, e, p, world, r, t);
+                emit();
+            }
+            world = compose_planar(world, edge_alignment(e));
+        }
+        const GraphNode& to = g.nodes[static_cast<size_t>(e.to)];
+        clip = to.clip;
+        frame = to.frame;
+    }
+    const int last = std::min(frame + frames_after, g.clips[static_cast<size_t>(clip)].frame_count - 1);
+    for (; frame <= last; ++frame) {
+        graph_frame_pose(g, g.clips[static_cast<size_t>(clip)].first_frame + frame, world, r, t);
+        emit();
+    }
+    return out;
+}
+
+}  // namespace marionette

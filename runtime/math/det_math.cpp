@@ -1,0 +1,124 @@
+#include "runtime/math/det_math.hpp"
+
+#include <cstdint>
+
+namespace marionette::det {
+
+namespace {
+// pi/2 split so that q*kPio2Hi is exact for |q| < 2^20.
+constexpr double kPio2Hi = 1.57079632673412561417e+00;
+constexpr double kPio2Lo = 6.07710050650619224932e-11;
+
+double sin_poly(double r) {
+    const double r2 = r * r;
+    // Taylor terms up to r^17: error < (pi/4)^19/19! ~ 1e-18.
+    double p = 1.0 / 355687428096000.0;    // 1/17!
+    p = p * r2 - 1.0 / 1307674368000.0;    // 1/15!
+    p = p * r2 + 1.0 / 6227020800.0;       // 1/13!
+    p = p * r2 - 1.0 / 39916800.0;         // 1/11!
+    p = p * r2 + 1.0 / 362880.0;           // 1/9!
+    p = p * r2 - 1.0 / 5040.0;             // 1/7!
+    p = p * r2 + 1.0 / 120.0;              // 1/5!
+    p = p * r2 - 1.0 / 6.0;                // 1/3!
+    return r + r * r2 * p;
+}
+
+double cos_poly(double r) {
+    const double r2 = r * r;
+    double p = 1.0 / 6402373705728000.0;   // 1/18!
+    p = p * r2 - 1.0 / 20922789888000.0;   // 1/16!
+    p = p * r2 + 1.0 / 87178291200.0;      // 1/14!
+    p = p * r2 - 1.0 / 479001600.0;        // 1/12!
+    p = p * r2 + 1.0 / 3628800.0;          // 1/10!
+    p = p * r2 - 1.0 / 40320.0;            // 1/8!
+    p = p * r2 + 1.0 / 720.0;              // 1/6!
+    p = p * r2 - 1.0 / 24.0;               // 1/4!
+    p = p * r2 + 0.5;                      // 1/2!
+    return 1.0 - r2 * p;
+}
+
+// atan on [0, tan(pi/8)] by its Taylor series (alternating, 0.4142^35/35 < 1e-15).
+double atan_small(double x) {
+    const double x2 = x * x;
+    double p = 0.0;
+    for (int k = 16; k >= 0; --k) {
+        const double term = 1.0 / static_cast<double>(2 * k + 1);
+        p = p * x2 + ((k % 2 == 0) ? term : -term);
+    }
+    return x * p;
+}
+}  // namespace
+
+void sin_cos(double x, double& s, double& c) {
+    if (!std::isfinite(x)) {
+        s = c = x - x;  // NaN
+        return;
+    }
+    // Very large arguments lose all meaning in float simulation anyway; reduce
+    // them coarsely first so q stays in range for the exact split.
+    if (x > 1.0e6 || x < -1.0e6) x = x - kTwoPi * std::nearbyint(x / kTwoPi);
+    const double q = std::nearbyint(x / kHalfPi);
+    const double r = (x - q * kPio2Hi) - q * kPio2Lo;
+    const double sr = sin_poly(r);
+    const double cr = cos_poly(r);
+    const int quadrant = static_cast<int>(static_cast<std::int64_t>(q) & 3);
+    switch (quadrant) {
+        case 0: s = sr; c = cr; break;
+        case 1: s = cr; c = -sr; break;
+        case 2: s = -sr; c = -cr; break;
+        default: s = -cr; c = sr; break;
+    }
+}
+
+double atan(double x) {
+    if (std::isnan(x)) return x;
+    const bool negative = x < 0.0;
+    double a = negative ? -x : x;
+    double result;
+    constexpr double kTan3Pi8 = 2.41421356237309504880;  // tan(3pi/8)
+    constexpr double kTanPi8 = 0.41421356237309504880;   // tan(pi/8)
+    if (a > kTan3Pi8) {
+        result = kHalfPi - atan_small(1.0 / a);
+    } else if (a > kTanPi8) {
+        result = kPi / 4.0 + atan_small((a - 1.0) / (a + 1.0));
+    } else {
+        result = atan_small(a);
+    }
+    return negative ? -result : result;
+}
+
+double atan2(double y, double x) {
+    if (std::isnan(x) || std::isnan(y)) return x + y;
+    if (x == 0.0) {
+        if (y > 0.0) return kHalfPi;
+        if (y < 0.0) return -kHalfPi;
+        return std::signbit(x) ? (std::signbit(y) ? -kPi : kPi) : y;
+    }
+    const double base = atan(y / x);
+    if (x > 0.0) return base;
+    return (y >= 0.0) ? base + kPi : base - kPi;
+}
+
+double acos(double x) {
+    if (std::isnan(x)) return x;
+    if (x > 1.0) x = 1.0;
+    if (x < -1.0) x = -1.0;
+    return atan2(std::sqrt((1.0 - x) * (1.0 + x)), x);
+}
+
+double asin(double x) {
+    if (std::isnan(x)) return x;
+    if (x > 1.0) x = 1.0;
+    if (x < -1.0) x = -1.0;
+    return atan2(x, std::sqrt((1.0 - x) * (1.0 + x)));
+}
+
+double wrap_angle(double radians) {
+    if (!std::isfinite(radians)) return 0.0;
+    double w = radians - kTwoPi * std::nearbyint(radians / kTwoPi);
+    if (w <= -kPi) w += kTwoPi;
+    if (w > kPi) w -= kTwoPi;
+    return w;
+}
+
+}  // namespace marionette::det

@@ -1,0 +1,109 @@
+#include "runtime/math/hermite_spline.hpp"
+
+#include <cmath>
+
+namespace marionette {
+
+namespace {
+float length_of(vec3 v) { return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z); }
+
+// Index of the segment [keys[i], keys[i+1]] holding `time` (keys.size() >= 2).
+std::size_t segment_of(std::span<const HermiteKey> keys, float time) {
+    std::size_t lo = 0;
+    std::size_t hi = keys.size() - 1;
+    while (hi - lo > 1) {
+        const std::size_t mid = (lo + hi) / 2;
+        if (keys[mid].time <= time) lo = mid;
+        else hi = mid;
+    }
+    return lo;
+}
+}  // namespace
+
+namespace {
+// Length of the curve over [t0, t1]: 3-point Gauss–Legendre on |velocity|
+// (nodes 0, ±sqrt(3/5), weights 8/9, 5/9).
+float gauss_length(std::span<const HermiteKey> keys, float t0, float t1) {
+    const float node = 0.7745966692414834f;
+    const float mid = 0.5f * (t0 + t1);
+    const float half = 0.5f * (t1 - t0);
+    const float speed_mid = length_of(sample_hermite(keys, mid).velocity);
+    const float speed_lo = length_of(sample_hermite(keys, mid - half * node).velocity);
+    const float speed_hi = length_of(sample_hermite(keys, mid + half * node).velocity);
+    return half * ((8.0f / 9.0f) * speed_mid + (5.0f / 9.0f) * (speed_lo + speed_hi));
+}
+}  // namespace
+
+HermiteBasis hermite_basis(float s) {
+    const float s2 = s * s;
+    const float s3 = s2 * s;
+    return {2.0f * s3 - 3.0f * s2 + 1.0f, s3 - 2.0f * s2 + s, -2.0f * s3 + 3.0f * s2, s3 - s2};
+}
+
+HermiteBasis hermite_basis_derivative(float s) {
+    const float s2 = s * s;
+    return {6.0f * s2 - 6.0f * s, 3.0f * s2 - 4.0f * s + 1.0f, -6.0f * s2 + 6.0f * s, 3.0f * s2 - 2.0f * s};
+}
+
+HermiteSample sample_hermite(std::span<const HermiteKey> keys, float time) {
+    if (keys.empty()) return {};
+    if (keys.size() == 1 || !(time > keys.front().time)) return {keys.front().position, vec3(0.0f)};
+    if (!(time < keys.back().time)) return {keys.back().position, vec3(0.0f)};
+    const std::size_t i = segment_of(keys, time);
+    const HermiteKey& a = keys[i];
+    const HermiteKey& b = keys[i + 1];
+    const float h = b.time - a.time;
+    if (!(h > 0.0f)) return {b.position, vec3(0.0f)};
+    const float s = (time - a.time) / h;
+    const HermiteBasis w = hermite_basis(s);
+    const HermiteBasis d = hermite_basis_derivative(s);
+    HermiteSample out;
+    out.position = a.position * w.h00 + a.tangent * (w.h10 * h) + b.position * w.h01 + b.tangent * (w.h11 * h);
+    out.velocity = (a.position * d.h00 + a.tangent * (d.h10 * h) + b.position * d.h01 + b.tangent * (d.h11 * h)) / h;
+    return out;
+}
+
+ArcLengthTable build_arc_length_table(std::span<const HermiteKey> keys) {
+    ArcLengthTable table;
+    if (keys.size() < 2) return table;
+    table.start_time = keys.front().time;
+    table.end_time = keys.back().time;
+    const float span = table.end_time - table.start_time;
+    const float dt = span / static_cast<float>(kArcLengthIntervals);
+    for (int i = 0; i < kArcLengthIntervals; ++i) {
+        const float t0 = table.start_time + dt * static_cast<float>(i);
+        const float piece = gauss_length(keys, t0, t0 + dt);
+        table.length[static_cast<std::size_t>(i) + 1] = table.length[static_cast<std::size_t>(i)] + piece;
+    }
+    return table;
+}
+
+float time_at_arc_length(std::span<const HermiteKey> keys, const ArcLengthTable& table, float distance) {
+    if (keys.size() < 2 || !(table.total() > 0.0f)) return table.start_time;
+    if (!(distance > 0.0f)) return table.start_time;
+    if (!(distance < table.total())) return table.end_time;
+    std::size_t lo = 0;
+    std::size_t hi = kArcLengthIntervals;
+    while (hi - lo > 1) {
+        const std::size_t mid = (lo + hi) / 2;
+        if (table.length[mid] <= distance) lo = mid;
+        else hi = mid;
+    }
+    const float dt = (table.end_time - table.start_time) / static_cast<float>(kArcLengthIntervals);
+    const float t_lo = table.start_time + dt * static_cast<float>(lo);
+    const float piece = table.length[lo + 1] - table.length[lo];
+    float t = t_lo + (piece > 0.0f ? (distance - table.length[lo]) / piece : 0.0f) * dt;
+    // Newton on f(t) = length(t) − distance, length(t) integrated from the
+    // bracket start with the same Gauss–Legendre rule; stays inside the bracket.
+    for (int iteration = 0; iteration < 2; ++iteration) {
+        const float speed_t = length_of(sample_hermite(keys, t).velocity);
+        if (!(speed_t > 1e-6f)) break;
+        const float covered = table.length[lo] + gauss_length(keys, t_lo, t);
+        t -= (covered - distance) / speed_t;
+        if (t < t_lo) t = t_lo;
+        if (t > t_lo + dt) t = t_lo + dt;
+    }
+    return t;
+}
+
+}  // namespace marionette

@@ -1,0 +1,110 @@
+#pragma once
+// Every tunable the simulation reads, as plain data, one struct per subsystem:
+// each job and each part of the tick is handed only its own part (the gait a
+// GaitConfig, the ground a TerrainConfig, ...). SimConfig is their sum, so the
+// schema and the logs treat it as one flat set of keys. Loading, validation and
+// the documentation of each key live with the TOML schema (app/config.cpp,
+// docs/config.md); the defaults here are the ones config/marionette.toml states.
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "runtime/gait/gait_config.hpp"
+#include "runtime/ground/terrain.hpp"
+#include "runtime/sim/tick_input.hpp"
+
+namespace marionette {
+
+// [motion] source: what poses the puppet. `automatic` is the motion graph when one
+// is attached (`--graph`), the gait otherwise.
+enum class MotionSourceSetting : std::int32_t { automatic = 0, gait = 1, graph = 2, graph_feet = 3 };
+// [motion_graph.buttons]: the graph label a button plays on press ("" for none),
+// and where the value came from, for the error when the graph lacks the label.
+struct GraphButtonBinding {
+    std::string label;
+    std::string file;           // configuration file that set it last
+    std::int32_t line = 0;      // 0: the built-in default
+};
+// Today's mapping: the face buttons play the default graph's actions.
+inline std::array<GraphButtonBinding, kButtonCount> default_graph_buttons() {
+    std::array<GraphButtonBinding, kButtonCount> b{};
+    b[static_cast<std::size_t>(Button::south)].label = "jump";
+    b[static_cast<std::size_t>(Button::east)].label = "wave";
+    b[static_cast<std::size_t>(Button::west)].label = "bow";
+    b[static_cast<std::size_t>(Button::north)].label = "look_around";
+    return b;
+}
+
+// [simulation]
+struct TickConfig {
+    std::int32_t tick_rate_hz = 240;
+    std::int32_t max_catch_up_ticks = 8;   // real-time driver: ticks run per wake-up at most
+
+};
+
+// [terrain]
+struct TerrainConfig {
+    // [terrain] the ground walked on: `name` is where it came from (a built-in
+    // name or a file path, resolved by app/); the data travel inline in every
+    // effective configuration, so a log fully determines its ground. Built-in
+    // default: flat (the shipped config/marionette.toml names stairs).
+    std::string terrain_name = "flat";
+    Terrain terrain;
+};
+
+// [motion]
+struct MotionSourceConfig {
+    // [motion] which source poses the puppet, and how a change of source blends
+    // (docs/motion-graph.md, "Motion sources")
+    MotionSourceSetting motion_source = MotionSourceSetting::automatic;
+    float motion_crossfade_s = 0.4f;              // a live change of source cross-fades over this long
+    float feet_release_s = 0.15f;                 // graph_feet: a lifted foot eases from its pin back to the clip
+    float feet_terrain_rate = 10.0f;              // graph_feet: 1/s the body follows the ground height
+};
+
+// [motion_graph]: the run-time keys (turned into a GraphControllerConfig when a
+// graph is attached) and the button map.
+struct MotionGraphConfig {
+    // [motion_graph] the run-time controller (runtime/graph/graph_controller.hpp)
+    float graph_horizon_s = 1.0f;                 // look-ahead of the stick-following search
+    std::int32_t graph_max_nodes_per_tick = 64;   // search nodes expanded per tick at most
+    float graph_full_stick_speed = 1.5f;          // leg lengths per second at full stick
+    float graph_leg_metres = 0.9f;                // the graph's leg is scaled to this many metres
+    float graph_attract_after_s = 30.0f;          // seconds without input before the attract-mode walk
+    float graph_attract_temperature = 1.0f;       // attract walk: edge weight 1 / (1 + cost / temperature)
+    std::int32_t graph_attract_seed = 1;          // attract-mode PRNG seed
+    // [motion_graph.buttons] button bit → label (runtime/sim/tick_input.hpp kButtonNames order)
+    std::array<GraphButtonBinding, kButtonCount> graph_buttons = default_graph_buttons();
+};
+
+// [realtime]: read by `marionette run` only, never by the tick.
+struct RealtimeConfig {
+    // [realtime] `marionette run` thread settings (app/realtime.cpp); never read by
+    // the tick. Priority 0 = normal scheduling, 1–99 = SCHED_FIFO; cpu −1 = any.
+    std::int32_t input_priority = 0;
+    std::int32_t simulation_priority = 0;
+    std::int32_t render_priority = 0;
+    std::int32_t input_cpu = -1;
+    std::int32_t simulation_cpu = -1;
+    std::int32_t render_cpu = -1;
+    std::int32_t lock_memory = 0;          // 1: mlockall(MCL_CURRENT | MCL_FUTURE) before the threads start
+};
+
+// [motion_graph]: the offline build's parameters, read by graph builds only.
+struct GraphBuildConfig {
+    // [motion_graph] build parameters and path costs (docs/motion-graph.md)
+    std::int32_t graph_analysis_rate_hz = 30;     // clips are resampled to this rate for the build
+    std::int32_t graph_window_frames = 10;        // k: distance window and transition length
+    std::int32_t graph_neighbourhood_frames = 4;  // local minima over (2h+1)² pairs
+    float graph_threshold_percentile = 5.0f;      // threshold as a percentile of all distances
+    float graph_threshold_absolute = 0.0f;        // > 0: absolute threshold (leg lengths²) instead
+    float graph_bridge_percentile = 90.0f;        // looser percentile for bridges into cut-off clips
+    float graph_contact_height = 0.08f;           // foot contact: height above ground, leg lengths
+    float graph_contact_speed = 0.6f;             // foot contact: speed, leg lengths per second
+    float graph_transition_weight = 1.0f;         // path cost: seconds per unit of transition distance
+};
+
+struct SimConfig : TickConfig, GaitConfig, TerrainConfig, MotionSourceConfig, MotionGraphConfig,
+                   RealtimeConfig, GraphBuildConfig {};
+
+}  // namespace marionette

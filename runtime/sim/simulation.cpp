@@ -1,0 +1,445 @@
+#include "runtime/sim/simulation.hpp"
+
+// Static-linking API: lets the hash state live on the stack (no allocation per tick).
+#define XXH_STATIC_LINKING_ONLY
+#include <xxhash.h>
+
+#include <initializer_list>
+#include <stdexcept>
+
+#include "runtime/math/det_math.hpp"
+#include "runtime/gait/puppet.hpp"
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <xmmintrin.h>
+#endif
+
+namespace marionette {
+
+namespace {
+float clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
+
+void hash_floats(XXH64_state_t* h, const float* v, size_t n) { XXH64_update(h, v, n * sizeof(float)); }
+void hash_ints(XXH64_state_t* h, std::initializer_list<std::int32_t> v) { XXH64_update(h, v.begin(), v.size() * sizeof(std::int32_t)); }
+void hash_vec(XXH64_state_t* h, vec3 v) {
+    const float f[3] = {v.x, v.y, v.z};
+    hash_floats(h, f, 3);
+}
+void hash_quat(XXH64_state_t* h, quat q) {
+    const float f[4] = {q.w, q.x, q.y, q.z};
+    hash_floats(h, f, 4);
+}
+
+// Every field of the gait state, one by one (no padding enters the hash).
+void hash_gait(XXH64_state_t* h, const GaitState& g) {
+    for (const FootState& f : g.feet) {
+        hash_vec(h, f.ankle);
+        hash_quat(h, f.rotation);
+        hash_vec(h, f.start);
+        hash_quat(h, f.start_rotation);
+        hash_vec(h, f.target);
+        hash_quat(h, f.target_rotation);
+        const float scalars[8] = {f.ground, f.start_ground, f.target_ground, f.progress, f.fraction, f.lift_phase, f.timed_rate, f.lift_scale};
+        hash_floats(h, scalars, 8);
+        hash_floats(h, f.path_height.data(), f.path_height.size());
+        hash_floats(h, f.path_length.length.data(), f.path_length.length.size());
+        hash_ints(h, {f.swinging, f.replanned});
+        const float plan[2] = {f.planned_speed, f.planned_heading};
+        hash_floats(h, plan, 2);
+    }
+    hash_vec(h, g.pelvis);
+    const float scalars[7] = {g.cycle_phase, g.speed, g.commanded_speed, g.run_blend, g.pelvis_base, g.lean, g.activity};
+    hash_floats(h, scalars, 7);
+    hash_ints(h, {static_cast<std::int32_t>(g.mode), g.turning_in_place, g.first_step, g.steps, g.flight_phases, g.flight_phases_open});
+}
+// The graph controller's state, field by field (gait-driven states skip it, so
+// their hashes are what they were before the graph existed).
+void hash_graph(XXH64_state_t* h, std::int32_t source, const GraphControllerState& g) {
+    hash_ints(h, {source, g.edge, static_cast<std::int32_t>(g.mode), g.last_buttons, g.action_label,
+                  g.action_path_length, g.action_path_next, g.search_depth, g.best_edge, g.contacts});
+    const double world[3] = {g.world_angle, g.world_dx, g.world_dz};
+    XXH64_update(h, world, sizeof world);
+    const float scalars[5] = {g.edge_position, g.idle_seconds, g.best_score, g.desired_vx, g.desired_vz};
+    hash_floats(h, scalars, 5);
+    const std::int64_t counters[6] = {g.decisions, g.transitions_taken, g.actions_played, g.nodes_expanded,
+                                      static_cast<std::int64_t>(g.rng), g.action_search_pops};
+    XXH64_update(h, counters, sizeof counters);
+    XXH64_update(h, g.action_path.data(), g.action_path.size() * sizeof(std::int32_t));
+    for (const GraphSearchLevel& l : g.search) {
+        hash_ints(h, {l.node, l.next_edge, l.first_edge});
+        const float f[2] = {l.seconds, l.cost};
+        hash_floats(h, f, 2);
+        const double w[3] = {l.angle, l.dx, l.dz};
+        XXH64_update(h, w, sizeof w);
+    }
+}
+}  // namespace
+
+void set_simulation_float_mode() {
+#if defined(__x86_64__) || defined(__i386__)
+    _mm_setcsr(_mm_getcsr() | 0x8040u);  // FTZ (bit 15) | DAZ (bit 6)
+#elif defined(__aarch64__)
+    std::uint64_t fpcr = 0;
+    __asm__ volatile("mrs %0, fpcr" : "=r"(fpcr));
+    fpcr |= (1ull << 24);  // FZ
+    __asm__ volatile("msr fpcr, %0" : : "r"(fpcr));
+#endif
+}
+
+Simulation::Simulation(const SimConfig& config, const Terrain& terrain) : config_(config), terrain_(terrain) {
+    if (config_.tick_rate_hz <= 0) throw std::invalid_argument("tick_rate_hz must be positive");
+    const Skeleton skeleton = make_puppet_skeleton(config_);
+    if (skeleton.joint_count() > kMaxJoints) throw std::invalid_argument("puppet has too many joints");
+    idle_clip_ = make_idle_clip(skeleton, config_);
+    walk_clip_ = make_walk_clip(skeleton, config_);
+    clip_data_hash_ = hash_clip(idle_clip_) ^ (hash_clip(walk_clip_) * 0x9E3779B97F4A7C15ull);
+    // Tick 0: standing on the terrain at the origin, so even a run of no ticks has a full pose.
+    state_.joint_count = skeleton.joint_count();
+    rig_ = make_gait_rig(config_);
+    state_.gait = initial_gait_state(config_, rig_, terrain_, vec3(0.0f), 0.0f);
+    state_.gait_root.position = vec3(0.0f, state_.gait.pelvis_base, 0.0f);
+    pose_gait(gait_pose_);
+    output(gait_pose_, kSourceGait, 0.0f);
+}
+
+std::int32_t resolve_motion_source(const SimConfig& config, bool graph_attached) {
+    if (!graph_attached) return kSourceGait;
+    switch (config.motion_source) {
+        case MotionSourceSetting::gait: return kSourceGait;
+        case MotionSourceSetting::graph_feet: return kSourceGraphFeet;
+        case MotionSourceSetting::automatic:
+        case MotionSourceSetting::graph: break;
+    }
+    return kSourceGraph;
+}
+
+std::string structural_change(const SimConfig& c, const SimConfig& next) {
+    if (next.tick_rate_hz != c.tick_rate_hz) return "simulation.tick_rate_hz";
+    const float SimConfig::*const structural[] = {
+        &SimConfig::pelvis_height, &SimConfig::hip_width, &SimConfig::thigh_length, &SimConfig::shin_length,
+        &SimConfig::ankle_height, &SimConfig::foot_length, &SimConfig::toe_length, &SimConfig::spine_length,
+        &SimConfig::neck_length, &SimConfig::head_length, &SimConfig::shoulder_width,
+        &SimConfig::upper_arm_length, &SimConfig::forearm_length, &SimConfig::hand_length};
+    for (auto field : structural)
+        if (next.*field != c.*field) return "puppet (skeleton proportions)";
+    if (!(next.terrain == c.terrain)) return "terrain";
+    return {};
+}
+
+std::string Simulation::retune(const SimConfig& next) {
+    std::string key = structural_change(config_, next);
+    if (!key.empty()) return key;
+    key = motion_source_refusal(next);
+    if (!key.empty()) return key;
+    const std::int32_t source = resolve_motion_source(next, graph_ != nullptr);
+    const std::int32_t current = state_.motion_source;
+    config_ = next;
+    rig_ = make_gait_rig(config_);
+    if (source != current) begin_source_change(source);
+    return {};
+}
+
+std::string Simulation::motion_source_refusal(const SimConfig& next) const {
+    const bool wants_graph =
+        next.motion_source == MotionSourceSetting::graph || next.motion_source == MotionSourceSetting::graph_feet;
+    if (!graph_ && wants_graph)
+        return "motion.source (no motion graph is attached: start with --graph, or with this source in the configuration)";
+    const std::int32_t source = resolve_motion_source(next, graph_ != nullptr);
+    // Without a shared skeleton the puppet never leaves the family (gait or
+    // graph) it started in, so comparing with the start is the same as with now.
+    if ((source == kSourceGait) == skeleton_from_graph_ && !graph_matches_puppet_ && graph_)
+        return "motion.source (the motion graph's skeleton is not the puppet's, so gait and graph cannot blend)";
+    if (source == kSourceGraphFeet && !foot_rig_.valid)
+        return "motion.source (graph_feet: the motion graph names no foot joints with a knee and a hip)";
+    return {};
+}
+
+void Simulation::use_motion_graph(std::shared_ptr<const MotionGraph> graph, const GraphControllerConfig& config,
+                                  double metres_per_unit) {
+    if (state_.tick != 0) throw std::invalid_argument("a motion graph can only be attached before the first tick");
+    if (!graph) throw std::invalid_argument("no motion graph given");
+    if (graph_) throw std::invalid_argument("a motion graph is already attached");
+    if (graph->joint_count() > kMaxJoints) throw std::invalid_argument("motion graph skeleton has too many joints");
+    if (!(metres_per_unit > 0.0)) throw std::invalid_argument("metres_per_unit must be positive");
+    auto controller = std::make_unique<GraphController>(*graph, config);  // validates the graph
+    const FootPlacementRig foot_rig =
+        make_foot_placement_rig(std::span<const int>(graph->skeleton.parents), graph->left_foot, graph->right_foot);
+    const std::int32_t source = resolve_motion_source(config_, true);
+    if (source == kSourceGraphFeet && !foot_rig.valid)
+        throw std::invalid_argument("motion.source graph_feet: the motion graph names no foot joints with a knee and a hip");
+    const Skeleton& puppet = idle_clip_.skeleton;
+    graph_matches_puppet_ = graph->skeleton.parents == puppet.parents && graph->skeleton.joint_names == puppet.joint_names;
+    const std::vector<std::uint8_t> bytes = serialize_motion_graph(*graph);
+    clip_data_hash_ ^= XXH64(bytes.data(), bytes.size(), 0x6D67726170680001ull);
+    graph_ = std::move(graph);
+    graph_controller_ = std::move(controller);
+    foot_rig_ = foot_rig;
+    metres_per_unit_ = static_cast<float>(metres_per_unit);
+    skeleton_from_graph_ = source != kSourceGait;
+    state_.graph_attached = 1;
+    state_.motion_source = source;
+    state_.joint_count = skeleton().joint_count();
+    state_.graph = graph_controller_->initial_state();
+    if (source == kSourceGait) return;
+    step_graph(TickInput{}, 0.0f, graph_pose_);
+    if (source == kSourceGraphFeet) {
+        place_feet(graph_pose_, 0.0f, feet_pose_);
+        output(feet_pose_, source, 0.0f);
+    } else {
+        output(graph_pose_, source, 0.0f);
+    }
+}
+
+void Simulation::step_graph(const TickInput& input, float dt, Pose& out) {
+    PuppetState& s = state_;
+    const size_t n = static_cast<size_t>(graph_->joint_count());
+    GraphControllerInput in;
+    in.stick_x = static_cast<float>(input.left_x) / kStickScale;
+    in.stick_y = static_cast<float>(input.left_y) / kStickScale;
+    in.buttons = input.buttons;
+    in.dt = dt;
+    const std::span<quat> local_r(out.local_rotations.data(), n);
+    const std::span<vec3> local_t(out.local_translations.data(), n);
+    if (dt > 0.0f) graph_controller_->step(s.graph, in, local_r, local_t);
+    else graph_controller_->pose(s.graph, local_r, local_t);
+    for (size_t j = 0; j < n; ++j) out.local_translations[j] *= metres_per_unit_;
+    const LocalToModelJob fk{std::span<const int>(graph_->skeleton.parents), local_r, local_t,
+                             std::span<quat>(out.model_rotations.data(), n), std::span<vec3>(out.model_positions.data(), n)};
+    fk.run();
+}
+
+void Simulation::place_feet(const Pose& clip, float dt, Pose& out) {
+    out = clip;
+    const size_t n = static_cast<size_t>(graph_->joint_count());
+    const FootPlacementJob job{&state_.feet,
+                               &foot_rig_,
+                               &terrain_,
+                               state_.graph.contacts,
+                               dt,
+                               config_.feet_release_s,
+                               config_.feet_terrain_rate,
+                               std::span<const int>(graph_->skeleton.parents),
+                               std::span<quat>(out.local_rotations.data(), n),
+                               std::span<vec3>(out.local_translations.data(), n),
+                               std::span<quat>(out.model_rotations.data(), n),
+                               std::span<vec3>(out.model_positions.data(), n)};
+    job.run();
+}
+
+void Simulation::pose_gait(Pose& out) const {
+    const Skeleton& puppet = idle_clip_.skeleton;
+    const size_t n = static_cast<size_t>(puppet.joint_count());
+    const GaitPoseJob job{&state_.gait,
+                          &rig_,
+                          &config_,
+                          state_.gait_root.heading,
+                          state_.idle_time,
+                          std::span<const int>(puppet.parents),
+                          std::span<const vec3>(puppet.rest_offsets),
+                          std::span<quat>(out.local_rotations.data(), n),
+                          std::span<vec3>(out.local_translations.data(), n),
+                          std::span<quat>(out.model_rotations.data(), n),
+                          std::span<vec3>(out.model_positions.data(), n)};
+    job.run();
+}
+
+void Simulation::step_gait(const TickInput& input, float dt, Pose& out) {
+    const SimConfig& c = config_;
+    PuppetState& s = state_;
+    // The gait plans (stick → velocity, steps, pelvis); the pose comes from its state.
+    GaitTickInput gait_input;
+    gait_input.stick_x = static_cast<float>(input.left_x) / kStickScale;
+    gait_input.stick_y = static_cast<float>(input.left_y) / kStickScale;
+    gait_input.dt = dt;
+    gait_input.breath_time = s.idle_time;
+    update_gait(s.gait, s.gait_root.position, s.gait_root.heading, s.gait_root.velocity, gait_input, c, rig_, terrain_);
+    s.locomotion_blend = clampf(s.gait.speed / c.walk_cycle_speed, 0.0f, 1.0f);
+    s.walk_phase = s.gait.cycle_phase;
+    s.idle_time += dt;
+    if (s.idle_time >= c.breath_period_s) s.idle_time -= c.breath_period_s;
+    pose_gait(out);
+}
+
+namespace {
+float heading_of(quat root_rotation) {
+    const vec3 forward = quat_rotate(root_rotation, vec3(0.0f, 0.0f, 1.0f));
+    return static_cast<float>(det::atan2(forward.x, forward.z));
+}
+float smoothstep(float u) { return u * u * (3.0f - 2.0f * u); }
+}  // namespace
+
+// The facing of a graph pose: the root's +Z turned by the graph's facing offset
+// (the clips' forward as the controller measured it from their travel).
+float Simulation::graph_heading(quat root_rotation) const {
+    return static_cast<float>(det::wrap_angle(heading_of(root_rotation) + graph_controller_->facing_offset()));
+}
+
+// Where a source puts the puppet's root (ground point under the pelvis) and which way it faces.
+void Simulation::output(const Pose& pose, std::int32_t source, float dt) {
+    PuppetState& s = state_;
+    const size_t n = static_cast<size_t>(s.joint_count);
+    for (size_t j = 0; j < n; ++j) {
+        s.local_rotations[j] = pose.local_rotations[j];
+        s.local_translations[j] = pose.local_translations[j];
+        s.model_rotations[j] = pose.model_rotations[j];
+        s.model_positions[j] = pose.model_positions[j];
+    }
+    if (source == kSourceGait) {
+        s.root_position = s.gait_root.position;
+        s.velocity = s.gait_root.velocity;
+        s.heading = s.gait_root.heading;
+        return;
+    }
+    const size_t root = static_cast<size_t>(foot_rig_.root);
+    const vec3 p = pose.model_positions[root];
+    const vec2 before(s.root_position.x, s.root_position.z);
+    s.root_position = vec3(p.x, source == kSourceGraphFeet ? s.feet.body_offset : 0.0f, p.z);
+    if (dt > 0.0f) s.velocity = (vec2(p.x, p.z) - before) / dt;
+    s.heading = graph_heading(pose.model_rotations[root]);
+}
+
+// The cross-fade of a change of source: local rotations slerped, translations
+// and roots lerped, headings along the shorter arc (both sources share the
+// puppet's skeleton: retune refuses otherwise).
+void Simulation::output_blend(const Pose& from, const Pose& to, float weight, float dt) {
+    PuppetState& s = state_;
+    const size_t n = static_cast<size_t>(s.joint_count);
+    auto root_of = [&](std::int32_t source, const Pose& pose, vec3& position, float& heading) {
+        if (source == kSourceGait) {
+            position = s.gait_root.position;
+            heading = s.gait_root.heading;
+            return;
+        }
+        const size_t root = static_cast<size_t>(foot_rig_.root);
+        position = vec3(pose.model_positions[root].x, source == kSourceGraphFeet ? s.feet.body_offset : 0.0f,
+                        pose.model_positions[root].z);
+        heading = graph_heading(pose.model_rotations[root]);
+    };
+    vec3 p_from, p_to;
+    float h_from = 0.0f, h_to = 0.0f;
+    root_of(s.fade.from, from, p_from, h_from);
+    root_of(s.motion_source, to, p_to, h_to);
+    for (size_t j = 0; j < n; ++j) {
+        s.local_rotations[j] = quat_slerp(from.local_rotations[j], to.local_rotations[j], weight);
+        s.local_translations[j] = lerp(from.local_translations[j], to.local_translations[j], weight);
+    }
+    const LocalToModelJob fk{std::span<const int>(skeleton().parents), std::span<const quat>(s.local_rotations.data(), n),
+                             std::span<const vec3>(s.local_translations.data(), n),
+                             std::span<quat>(s.model_rotations.data(), n), std::span<vec3>(s.model_positions.data(), n)};
+    fk.run();
+    const vec2 before(s.root_position.x, s.root_position.z);
+    s.root_position = lerp(p_from, p_to, weight);
+    if (dt > 0.0f) s.velocity = (vec2(s.root_position.x, s.root_position.z) - before) / dt;
+    s.heading = static_cast<float>(det::wrap_angle(h_from + det::wrap_angle(static_cast<double>(h_to) - h_from) * weight));
+}
+
+void Simulation::begin_source_change(std::int32_t source) {
+    PuppetState& s = state_;
+    const std::int32_t current = s.motion_source;
+    if (s.fade.duration > 0.0f && s.fade.from == source) {
+        // Back to where a running fade came from: the same fade, run backwards.
+        s.fade.from = current;
+        s.fade.elapsed = s.fade.duration - s.fade.elapsed;
+        s.motion_source = source;
+        return;
+    }
+    if (source == kSourceGait) {
+        // The gait starts standing where the puppet is, facing its way.
+        const vec3 p = s.root_position;
+        s.gait = initial_gait_state(config_, rig_, terrain_, vec3(p.x, 0.0f, p.z), s.heading);
+        s.gait_root.position = vec3(p.x, s.gait.pelvis_base, p.z);
+        s.gait_root.velocity = vec2(0.0f);
+        s.gait_root.heading = s.heading;
+    } else if (current == kSourceGait) {
+        // Re-place the graph's motion so its root is where the puppet is, facing its way.
+        const size_t n = static_cast<size_t>(graph_->joint_count());
+        graph_controller_->pose(s.graph, std::span<quat>(blend_pose_.local_rotations.data(), n),
+                                std::span<vec3>(blend_pose_.local_translations.data(), n));
+        const size_t root = static_cast<size_t>(foot_rig_.root);
+        const vec3 r = blend_pose_.local_translations[root];
+        const double turn = det::wrap_angle(static_cast<double>(s.heading) - graph_heading(blend_pose_.local_rotations[root]));
+        double sn = 0.0, cs = 0.0;
+        det::sin_cos(turn, sn, cs);
+        const PlanarTransform anchor{turn, s.root_position.x / metres_per_unit_ - (cs * r.x + sn * r.z),
+                                     s.root_position.z / metres_per_unit_ - (-sn * r.x + cs * r.z)};
+        const PlanarTransform world = compose_planar(anchor, {s.graph.world_angle, s.graph.world_dx, s.graph.world_dz});
+        s.graph.world_angle = world.angle, s.graph.world_dx = world.dx, s.graph.world_dz = world.dz;
+        s.graph.search_depth = -1;  // the look-ahead was placed in the old frame: start it again
+        s.graph.best_edge = -1;
+    }
+    if (source == kSourceGraphFeet) s.feet = FootPlacementState{};
+    s.fade = MotionFade{};
+    if (config_.motion_crossfade_s > 0.0f) s.fade = MotionFade{current, 0.0f, config_.motion_crossfade_s};
+    s.motion_source = source;
+}
+
+void Simulation::step(const TickInput& input) {
+    const float dt = 1.0f / static_cast<float>(config_.tick_rate_hz);
+    PuppetState& s = state_;
+    s.input = input;
+    const bool fading = s.fade.duration > 0.0f;
+    const std::int32_t to = s.motion_source;
+    const std::int32_t from = fading ? s.fade.from : to;
+    // Every source in play advances (a fading one too, so its pose keeps moving).
+    if (to == kSourceGait || from == kSourceGait) step_gait(input, dt, gait_pose_);
+    if (to != kSourceGait || from != kSourceGait) step_graph(input, dt, graph_pose_);
+    if (to == kSourceGraphFeet || from == kSourceGraphFeet) place_feet(graph_pose_, dt, feet_pose_);
+    auto pose_of = [&](std::int32_t source) -> const Pose& {
+        return source == kSourceGait ? gait_pose_ : (source == kSourceGraph ? graph_pose_ : feet_pose_);
+    };
+    if (!fading) {
+        output(pose_of(to), to, dt);
+    } else {
+        s.fade.elapsed += dt;
+        const float u = s.fade.elapsed >= s.fade.duration ? 1.0f : s.fade.elapsed / s.fade.duration;
+        output_blend(pose_of(from), pose_of(to), smoothstep(u), dt);
+        if (u >= 1.0f) s.fade = MotionFade{};
+    }
+    ++s.tick;
+}
+
+std::uint64_t hash_state(const PuppetState& s) {
+    XXH64_state_t state_memory;
+    XXH64_state_t* h = &state_memory;
+    XXH64_reset(h, 0);
+    XXH64_update(h, &s.tick, sizeof s.tick);
+    XXH64_update(h, &s.joint_count, sizeof s.joint_count);
+    const std::int16_t axes[4] = {s.input.left_x, s.input.left_y, s.input.right_x, s.input.right_y};
+    const std::uint16_t triggers[2] = {s.input.left_trigger, s.input.right_trigger};
+    XXH64_update(h, axes, sizeof axes);
+    XXH64_update(h, triggers, sizeof triggers);
+    XXH64_update(h, &s.input.buttons, sizeof s.input.buttons);
+    const float scalars[8] = {s.root_position.x, s.root_position.y, s.root_position.z, s.velocity.x,
+                              s.velocity.y, s.heading, s.walk_phase, s.idle_time};
+    hash_floats(h, scalars, 8);
+    hash_floats(h, &s.locomotion_blend, 1);
+    hash_gait(h, s.gait);
+    if (s.graph_attached) {
+        hash_graph(h, s.motion_source, s.graph);
+        hash_ints(h, {s.fade.from, s.feet.started, s.feet.feet[0].contact, s.feet.feet[1].contact});
+        const float blend[6] = {s.fade.elapsed, s.fade.duration, s.gait_root.velocity.x, s.gait_root.velocity.y,
+                                s.gait_root.heading, s.feet.body_offset};
+        hash_floats(h, blend, 6);
+        hash_vec(h, s.gait_root.position);
+        for (const FootPin& f : s.feet.feet) {
+            hash_vec(h, f.pin);
+            hash_vec(h, f.placed);
+            hash_vec(h, f.clip_previous);
+            const float weights[3] = {f.ground, f.release, f.plant};
+            hash_floats(h, weights, 3);
+        }
+    }
+    const int n = s.joint_count < 0 ? 0 : (s.joint_count > kMaxJoints ? kMaxJoints : s.joint_count);
+    for (int j = 0; j < n; ++j) {
+        const size_t i = static_cast<size_t>(j);
+        const quat lr = s.local_rotations[i];
+        const vec3 lt = s.local_translations[i];
+        const quat mr = s.model_rotations[i];
+        const vec3 mp = s.model_positions[i];
+        const float v[14] = {lr.w, lr.x, lr.y, lr.z, lt.x, lt.y, lt.z, mr.w, mr.x, mr.y, mr.z, mp.x, mp.y, mp.z};
+        hash_floats(h, v, 14);
+    }
+    return XXH64_digest(h);
+}
+
+}  // namespace marionette

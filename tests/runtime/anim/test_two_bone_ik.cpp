@@ -1,0 +1,157 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "runtime/anim/two_bone_ik.hpp"
+
+using namespace marionette;
+
+namespace {
+float distance(vec3 a, vec3 b) {
+    const vec3 d = a - b;
+    return std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+}
+float dot(vec3 a, vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+bool finite(vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+TwoBoneIkInput leg(vec3 target) {
+    TwoBoneIkInput in;
+    in.root = vec3(0.09f, 0.9f, 0.0f);
+    in.target = target;
+    in.pole = vec3(0, 0, 1);
+    in.upper_length = 0.44f;
+    in.lower_length = 0.43f;
+    return in;
+}
+// The segment frames must carry the bones: −Y of each frame runs root → mid → end.
+void check_frames(const TwoBoneIkInput& in, const TwoBoneIkResult& r) {
+    CHECK(distance(in.root + quat_rotate(r.upper_rotation, vec3(0, -in.upper_length, 0)), r.mid) < 1e-5f);
+    CHECK(distance(r.mid + quat_rotate(r.lower_rotation, vec3(0, -in.lower_length, 0)), r.end) < 1e-5f);
+    CHECK(distance(quat_rotate(r.upper_rotation, vec3(1, 0, 0)), r.hinge_axis) < 1e-5f);
+    CHECK(distance(quat_rotate(r.lower_rotation, vec3(1, 0, 0)), r.hinge_axis) < 1e-5f);
+}
+}  // namespace
+
+TEST_CASE("two-bone IK reaches every reachable target within 0.1 mm with bone lengths kept", "[ik]") {
+    int solved = 0;
+    for (float x = -0.4f; x <= 0.4f; x += 0.1f)
+        for (float y = 0.0f; y <= 0.8f; y += 0.1f)
+            for (float z = -0.5f; z <= 0.5f; z += 0.1f) {
+                const TwoBoneIkInput in = leg(vec3(0.09f + x, y, z));
+                const float d = distance(in.root, in.target);
+                if (d > in.soft_reach_start * 0.87f || d < 0.02f) continue;
+                const TwoBoneIkResult r = solve_two_bone_ik(in);
+                INFO("target " << in.target.x << " " << in.target.y << " " << in.target.z);
+                REQUIRE(distance(r.end, in.target) <= 1e-4f);
+                CHECK(r.reached);
+                CHECK(distance(in.root, r.mid) == Approx(0.44f).margin(1e-5));
+                CHECK(distance(r.mid, r.end) == Approx(0.43f).margin(1e-5));
+                check_frames(in, r);
+                ++solved;
+            }
+    CHECK(solved > 300);
+}
+
+TEST_CASE("two-bone IK bends toward the pole: knees forward, elbows back", "[ik]") {
+    TwoBoneIkInput knee = leg(vec3(0.09f, 0.2f, 0.1f));
+    const TwoBoneIkResult r = solve_two_bone_ik(knee);
+    // The knee lies ahead (+Z) of the hip–ankle line.
+    const vec3 line = (knee.target - knee.root) / distance(knee.target, knee.root);
+    const vec3 offset = (r.mid - knee.root) - line * dot(r.mid - knee.root, line);
+    CHECK(offset.z > 0.05f);
+    CHECK(std::abs(offset.x) < 1e-5f);
+    TwoBoneIkInput elbow = knee;
+    elbow.pole = vec3(0, 0, -1);
+    const TwoBoneIkResult e = solve_two_bone_ik(elbow);
+    const vec3 elbow_offset = (e.mid - elbow.root) - line * dot(e.mid - elbow.root, line);
+    CHECK(elbow_offset.z < -0.05f);
+    CHECK(distance(e.end, elbow.target) < 1e-4f);
+}
+
+TEST_CASE("a straight limb gets the rest frame for either hinge sign", "[ik]") {
+    TwoBoneIkInput in = leg(vec3(0.09f, 0.9f - 0.87f * 0.5f, 0.0f));
+    in.soft_reach_start = 1.0f;
+    in.target = vec3(0.09f, 0.9f - 0.87f, 0.0f);  // exactly full extension, straight down
+    const TwoBoneIkResult r = solve_two_bone_ik(in);
+    CHECK(std::abs(r.upper_rotation.w) == Approx(1.0f).margin(1e-4));
+    CHECK(std::abs(r.lower_rotation.w) == Approx(1.0f).margin(1e-4));
+    in.pole = vec3(0, 0, -1);
+    in.hinge_sign = -1.0f;
+    const TwoBoneIkResult arm = solve_two_bone_ik(in);
+    CHECK(std::abs(arm.upper_rotation.w) == Approx(1.0f).margin(1e-4));
+    CHECK(distance(arm.hinge_axis, vec3(1, 0, 0)) < 1e-5f);
+}
+
+TEST_CASE("out-of-reach targets are approached softly, never snapped", "[ik]") {
+    const float full = 0.87f;
+    float previous_reach = 0.0f;
+    vec3 previous_mid(0.0f);
+    for (float d = 0.80f; d <= 1.40f; d += 0.002f) {
+        TwoBoneIkInput in = leg(vec3(0.09f, 0.9f - d * 0.8f, d * 0.6f));
+        const TwoBoneIkResult r = solve_two_bone_ik(in);
+        CHECK(r.reach < full);
+        CHECK(r.reach >= previous_reach);
+        CHECK(finite(r.mid));
+        // The end moves no faster than the target (slope ≤ 1) and the knee has no jump.
+        if (previous_reach > 0.0f) {
+            CHECK(r.reach - previous_reach <= 0.002f + 1e-6f);
+            CHECK(distance(r.mid, previous_mid) < 0.01f);
+        }
+        // The end stays on the root → target line.
+        const vec3 dir = (in.target - in.root) / distance(in.target, in.root);
+        CHECK(distance(r.end, in.root + dir * r.reach) < 1e-5f);
+        if (d > 0.9f) CHECK_FALSE(r.reached);
+        previous_reach = r.reach;
+        previous_mid = r.mid;
+    }
+    CHECK(previous_reach > 0.99f * full);
+}
+
+TEST_CASE("degenerate IK inputs give finite poses with the bone lengths kept", "[ik]") {
+    SECTION("target on the root") {
+        TwoBoneIkInput in = leg(vec3(0.09f, 0.9f, 0.0f));
+        const TwoBoneIkResult r = solve_two_bone_ik(in);
+        CHECK(finite(r.mid));
+        CHECK(finite(r.end));
+        CHECK(distance(in.root, r.mid) == Approx(0.44f).margin(1e-5));
+        CHECK(distance(r.mid, r.end) == Approx(0.43f).margin(1e-5));
+        check_frames(in, r);
+    }
+    SECTION("pole parallel to the limb") {
+        TwoBoneIkInput in = leg(vec3(0.09f, 0.4f, 0.0f));
+        in.pole = vec3(0, -1, 0);
+        const TwoBoneIkResult r = solve_two_bone_ik(in);
+        CHECK(distance(r.end, in.target) < 1e-4f);
+        check_frames(in, r);
+    }
+    SECTION("zero pole") {
+        TwoBoneIkInput in = leg(vec3(0.09f, 0.4f, 0.1f));
+        in.pole = vec3(0.0f);
+        const TwoBoneIkResult r = solve_two_bone_ik(in);
+        CHECK(distance(r.end, in.target) < 1e-4f);
+    }
+    SECTION("equal bones folded onto the root") {
+        TwoBoneIkInput in = leg(vec3(0.09f, 0.9f, 0.0f));
+        in.lower_length = in.upper_length;
+        const TwoBoneIkResult r = solve_two_bone_ik(in);
+        CHECK(finite(r.mid));
+        CHECK(distance(in.root, r.mid) == Approx(0.44f).margin(1e-4));
+    }
+    SECTION("validate rejects zero-length bones and non-finite values") {
+        TwoBoneIkInput in = leg(vec3(0.0f));
+        CHECK(in.validate());
+        in.upper_length = 0.0f;
+        CHECK_FALSE(in.validate());
+        in = leg(vec3(NAN, 0.0f, 0.0f));
+        CHECK_FALSE(in.validate());
+    }
+}
+
+TEST_CASE("quaternions from axes and from vector pairs", "[ik]") {
+    const quat q = quat_axis_angle(vec3(0.6f, 0.0f, 0.8f), 1.1);
+    const quat r = quat_from_axes(quat_rotate(q, vec3(1, 0, 0)), quat_rotate(q, vec3(0, 1, 0)), quat_rotate(q, vec3(0, 0, 1)));
+    CHECK(std::abs(quat_dot(q, r)) == Approx(1.0f).margin(1e-5));
+    const vec3 from = vec3(0, 1, 0);
+    const vec3 to = vec3(0.48f, 0.6f, 0.64f);
+    CHECK(distance(quat_rotate(quat_from_to(from, to), from), to) < 1e-5f);
+    CHECK(distance(quat_rotate(quat_from_to(from, -from), from), -from) < 1e-5f);
+}
