@@ -15,7 +15,7 @@
 #include <cstdlib>
 #include <random>
 
-#include "app/default_graph.hpp"
+#include "app/graph/default_graph.hpp"
 #include "graph_builder/graph_builder.hpp"
 #include "runtime/math/det_math.hpp"
 #include "runtime/graph/graph_controller.hpp"

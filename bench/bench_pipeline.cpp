@@ -10,10 +10,10 @@
 #include <atomic>
 #include <thread>
 
-#include "app/clock.hpp"
-#include "app/config.hpp"
-#include "app/pipeline.hpp"
-#include "app/program_source.hpp"
+#include "app/live/clock.hpp"
+#include "app/config/config.hpp"
+#include "app/live/pipeline.hpp"
+#include "app/config/program_source.hpp"
 #include "runtime/handoff/latest_value.hpp"
 #include "runtime/handoff/spsc_ring.hpp"
 

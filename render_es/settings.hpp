@@ -1,6 +1,6 @@
 #pragma once
 // Render settings: plain data. They never affect the simulation, so they live in
-// their own file (config/render.toml, loaded by app/render_config.cpp) and are
+// their own file (config/render.toml, loaded by app/config/render_config.cpp) and are
 // never recorded in input logs.
 #include <cstdint>
 

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "app/config.hpp"
+#include "app/config/config.hpp"
 
 namespace marionette::test {
 

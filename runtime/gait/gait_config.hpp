@@ -1,7 +1,7 @@
 #pragma once
 // What the gait and the puppet's build read from the configuration: the
 // [puppet], [locomotion] and [gait] tables (docs/config.md). Plain data; the
-// TOML schema and validation live in app/config.cpp.
+// TOML schema and validation live in app/config/config.cpp.
 #include "runtime/gait/gait_prototype.hpp"
 
 namespace marionette {

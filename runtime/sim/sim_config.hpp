@@ -3,7 +3,7 @@
 // each job and each part of the tick is handed only its own part (the gait a
 // GaitConfig, the ground a TerrainConfig, ...). SimConfig is their sum, so the
 // schema and the logs treat it as one flat set of keys. Loading, validation and
-// the documentation of each key live with the TOML schema (app/config.cpp,
+// the documentation of each key live with the TOML schema (app/config/config.cpp,
 // docs/config.md); the defaults here are the ones config/marionette.toml states.
 #include <array>
 #include <cstdint>
@@ -79,7 +79,7 @@ struct MotionGraphConfig {
 
 // [realtime]: read by `marionette run` only, never by the tick.
 struct RealtimeConfig {
-    // [realtime] `marionette run` thread settings (app/realtime.cpp); never read by
+    // [realtime] `marionette run` thread settings (app/live/realtime.cpp); never read by
     // the tick. Priority 0 = normal scheduling, 1–99 = SCHED_FIFO; cpu −1 = any.
     std::int32_t input_priority = 0;
     std::int32_t simulation_priority = 0;

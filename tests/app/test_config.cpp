@@ -1,7 +1,7 @@
 #include <catch2/catch.hpp>
 
-#include "app/config.hpp"
-#include "app/terrain_file.hpp"
+#include "app/config/config.hpp"
+#include "app/config/terrain_file.hpp"
 #include "tests/config_error_check.hpp"
 #include "tests/test_support.hpp"
 

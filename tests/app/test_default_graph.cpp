@@ -1,4 +1,4 @@
-// The embedded default motion graph (app/default_graph.hpp): the authored action
+// The embedded default motion graph (app/graph/default_graph.hpp): the authored action
 // clips import onto the puppet's skeleton, the pruned graph keeps every label,
 // its bytes are identical build to build, and paths through it stay continuous.
 #include <catch2/catch.hpp>
@@ -7,9 +7,9 @@
 #include <limits>
 #include <memory>
 
-#include "app/default_graph.hpp"
-#include "app/embedded.hpp"
-#include "app/graph_files.hpp"
+#include "app/graph/default_graph.hpp"
+#include "app/config/embedded.hpp"
+#include "app/graph/graph_files.hpp"
 #include "graph_builder/graph_prune.hpp"
 #include "graph_builder/transition_search.hpp"
 #include "graph_builder/clip_database.hpp"

@@ -1,4 +1,4 @@
-// gait-eval's metrics with a motion graph (app/gait_eval.cpp): stance comes from the
+// gait-eval's metrics with a motion graph (app/eval/gait_eval.cpp): stance comes from the
 // graph controller's foot contacts, the feet are the graph's own foot joints, and
 // a walk on the embedded default graph gives finite metrics with steps and a
 // measured speed hold.
@@ -6,10 +6,10 @@
 
 #include <cmath>
 
-#include "app/config.hpp"
-#include "app/default_graph.hpp"
-#include "app/gait_eval.hpp"
-#include "app/program_source.hpp"
+#include "app/config/config.hpp"
+#include "app/graph/default_graph.hpp"
+#include "app/eval/gait_eval.hpp"
+#include "app/config/program_source.hpp"
 #include "runtime/sim/simulation.hpp"
 
 using namespace marionette;

@@ -4,8 +4,8 @@
 // rule (a changed key must exist in the graph; a default one only warns).
 #include <catch2/catch.hpp>
 
-#include "app/config.hpp"
-#include "app/graph_files.hpp"
+#include "app/config/config.hpp"
+#include "app/graph/graph_files.hpp"
 #include "tests/graph_fixture.hpp"
 #include "tests/config_error_check.hpp"
 

@@ -8,9 +8,9 @@
 #include <cmath>
 #include <memory>
 
-#include "app/default_graph.hpp"
-#include "app/graph_files.hpp"
-#include "app/terrain_file.hpp"
+#include "app/graph/default_graph.hpp"
+#include "app/graph/graph_files.hpp"
+#include "app/config/terrain_file.hpp"
 #include "runtime/gait/puppet.hpp"
 #include "runtime/sim/simulation.hpp"
 #include "tests/graph_fixture.hpp"

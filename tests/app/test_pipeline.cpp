@@ -5,10 +5,10 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "app/config.hpp"
-#include "app/files.hpp"
-#include "app/pipeline.hpp"
-#include "app/replay.hpp"
+#include "app/config/config.hpp"
+#include "app/io/files.hpp"
+#include "app/live/pipeline.hpp"
+#include "app/eval/replay.hpp"
 
 using namespace marionette;
 

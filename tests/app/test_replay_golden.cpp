@@ -7,9 +7,9 @@
 
 #include <sstream>
 
-#include "app/config.hpp"
-#include "app/program_source.hpp"
-#include "app/replay.hpp"
+#include "app/config/config.hpp"
+#include "app/config/program_source.hpp"
+#include "app/eval/replay.hpp"
 #include "tests/test_support.hpp"
 
 using namespace marionette;
@@ -104,8 +104,8 @@ TEST_CASE("a log whose clip data differ from this build is refused", "[golden]")
 #include <fmt/format.h>
 #include <xxhash.h>
 
-#include "app/default_graph.hpp"
-#include "app/graph_files.hpp"
+#include "app/graph/default_graph.hpp"
+#include "app/graph/graph_files.hpp"
 
 namespace {
 struct GraphGolden {

@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "app/config.hpp"
-#include "app/terrain_file.hpp"
+#include "app/config/config.hpp"
+#include "app/config/terrain_file.hpp"
 #include "tests/config_error_check.hpp"
 
 using namespace marionette;

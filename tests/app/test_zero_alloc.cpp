@@ -12,9 +12,9 @@
 #include <cstdlib>
 #include <new>
 
-#include "app/config.hpp"
-#include "app/pipeline.hpp"
-#include "app/program_source.hpp"
+#include "app/config/config.hpp"
+#include "app/live/pipeline.hpp"
+#include "app/config/program_source.hpp"
 
 namespace {
 std::atomic<bool> g_counting{false};

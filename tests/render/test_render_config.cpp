@@ -2,7 +2,7 @@
 // documentation of every key in docs/render.md.
 #include <catch2/catch.hpp>
 
-#include "app/render_config.hpp"
+#include "app/config/render_config.hpp"
 #include "tests/test_support.hpp"
 
 using namespace marionette;

@@ -11,10 +11,10 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "app/config.hpp"
-#include "app/program_source.hpp"
-#include "app/render_config.hpp"
-#include "app/replay.hpp"
+#include "app/config/config.hpp"
+#include "app/config/program_source.hpp"
+#include "app/config/render_config.hpp"
+#include "app/eval/replay.hpp"
 #include "render_es/gl_util.hpp"
 #include "render_es/image.hpp"
 #include "render_es/view.hpp"

@@ -1,9 +1,9 @@
-// marionette: the command line. Each command group registers itself (app/cli.hpp);
+// marionette: the command line. Each command group registers itself (app/cli/cli.hpp);
 // main turns errors into messages and exit codes: 0 ok, 1 failure, 2 bad input.
 #include <fmt/format.h>
 
-#include "app/cli.hpp"
-#include "app/config.hpp"
+#include "app/cli/cli.hpp"
+#include "app/config/config.hpp"
 #include "runtime/errors/import_error.hpp"
 
 int main(int argc, char** argv) {

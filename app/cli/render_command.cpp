@@ -11,11 +11,11 @@
 #include <sstream>
 #include <sys/wait.h>
 
-#include "app/cli.hpp"
-#include "app/config.hpp"
-#include "app/files.hpp"
-#include "app/render_config.hpp"
-#include "app/replay.hpp"
+#include "app/cli/cli.hpp"
+#include "app/config/config.hpp"
+#include "app/io/files.hpp"
+#include "app/config/render_config.hpp"
+#include "app/eval/replay.hpp"
 #include "render_es/image.hpp"
 #include "render_es/interpolate.hpp"
 #include "render_es/view.hpp"

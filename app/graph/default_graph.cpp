@@ -1,5 +1,5 @@
-// The embedded default motion graph (app/default_graph.hpp).
-#include "app/default_graph.hpp"
+// The embedded default motion graph (app/graph/default_graph.hpp).
+#include "app/graph/default_graph.hpp"
 
 #include <fmt/format.h>
 
@@ -7,8 +7,8 @@
 #include <chrono>
 #include <stdexcept>
 
-#include "app/embedded.hpp"
-#include "app/graph_files.hpp"
+#include "app/config/embedded.hpp"
+#include "app/graph/graph_files.hpp"
 #include "graph_builder/clip_database.hpp"
 #include "runtime/formats/bvh.hpp"
 #include "runtime/sim/simulation.hpp"

@@ -7,11 +7,11 @@
 #include <memory>
 #include <stdexcept>
 
-#include "app/cli.hpp"
-#include "app/embedded.hpp"
-#include "app/files.hpp"
-#include "app/json.hpp"
-#include "app/program_source.hpp"
+#include "app/cli/cli.hpp"
+#include "app/config/embedded.hpp"
+#include "app/io/files.hpp"
+#include "app/io/json.hpp"
+#include "app/config/program_source.hpp"
 #include "firmware_sim/sim_pad.hpp"
 #include "input/calibration.hpp"
 #include "input/evdev/evdev_backend.hpp"

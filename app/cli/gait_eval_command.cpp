@@ -5,13 +5,13 @@
 
 #include <memory>
 
-#include "app/cli.hpp"
-#include "app/config.hpp"
-#include "app/gait_eval.hpp"
-#include "app/graph_files.hpp"
-#include "app/json.hpp"
-#include "app/program_source.hpp"
-#include "app/terrain_file.hpp"
+#include "app/cli/cli.hpp"
+#include "app/config/config.hpp"
+#include "app/eval/gait_eval.hpp"
+#include "app/graph/graph_files.hpp"
+#include "app/io/json.hpp"
+#include "app/config/program_source.hpp"
+#include "app/config/terrain_file.hpp"
 
 namespace marionette {
 

@@ -1,5 +1,5 @@
 // `marionette run`: the live program. It chooses the input and display, prepares
-// the pipeline (app/pipeline.hpp: input, simulation, render and writer threads),
+// the pipeline (app/live/pipeline.hpp: input, simulation, render and writer threads),
 // turns SIGINT/SIGTERM into a clean stop, and reports the run's statistics.
 #include <fmt/format.h>
 
@@ -8,23 +8,23 @@
 #include <limits>
 #include <memory>
 
-#include "app/cli.hpp"
-#include "app/clock.hpp"
-#include "app/commands.hpp"
-#include "app/config.hpp"
-#include "app/files.hpp"
-#include "app/graph_files.hpp"
-#include "app/graph_rebuild.hpp"
-#include "app/json.hpp"
-#include "app/pipeline.hpp"
-#include "app/program_source.hpp"
-#include "app/embedded.hpp"
-#include "app/render_config.hpp"
+#include "app/cli/cli.hpp"
+#include "app/live/clock.hpp"
+#include "app/cli/commands.hpp"
+#include "app/config/config.hpp"
+#include "app/io/files.hpp"
+#include "app/graph/graph_files.hpp"
+#include "app/graph/graph_rebuild.hpp"
+#include "app/io/json.hpp"
+#include "app/live/pipeline.hpp"
+#include "app/config/program_source.hpp"
+#include "app/config/embedded.hpp"
+#include "app/config/render_config.hpp"
 #include "input/evdev/evdev_backend.hpp"
 #include "input/hid/hidapi_transport.hpp"
 #include "input/input_thread.hpp"
 #include "input/sdl/sdl_backend.hpp"
-#include "app/replay.hpp"
+#include "app/eval/replay.hpp"
 
 namespace marionette {
 

@@ -1,4 +1,4 @@
-#include "app/graph_rebuild.hpp"
+#include "app/graph/graph_rebuild.hpp"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -8,9 +8,9 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "app/embedded.hpp"
-#include "app/files.hpp"
-#include "app/graph_files.hpp"
+#include "app/config/embedded.hpp"
+#include "app/io/files.hpp"
+#include "app/graph/graph_files.hpp"
 
 namespace marionette {
 

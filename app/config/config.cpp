@@ -1,4 +1,4 @@
-#include "app/config.hpp"
+#include "app/config/config.hpp"
 
 #include <toml++/toml.h>
 
@@ -9,8 +9,8 @@
 #include <sstream>
 #include <variant>
 
-#include "app/embedded.hpp"
-#include "app/terrain_file.hpp"
+#include "app/config/embedded.hpp"
+#include "app/config/terrain_file.hpp"
 
 namespace marionette {
 

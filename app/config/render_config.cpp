@@ -1,4 +1,4 @@
-#include "app/render_config.hpp"
+#include "app/config/render_config.hpp"
 
 #include <toml++/toml.h>
 
@@ -6,8 +6,8 @@
 #include <cmath>
 #include <functional>
 
-#include "app/embedded.hpp"
-#include "app/files.hpp"
+#include "app/config/embedded.hpp"
+#include "app/io/files.hpp"
 
 namespace marionette {
 

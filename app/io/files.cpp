@@ -1,4 +1,4 @@
-#include "app/files.hpp"
+#include "app/io/files.hpp"
 
 #include <cerrno>
 #include <cstring>

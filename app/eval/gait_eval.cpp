@@ -1,4 +1,4 @@
-#include "app/gait_eval.hpp"
+#include "app/eval/gait_eval.hpp"
 
 #include <fmt/format.h>
 
@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "app/graph_files.hpp"
+#include "app/graph/graph_files.hpp"
 #include "runtime/gait/gait.hpp"
 #include "runtime/gait/puppet.hpp"
 #include "runtime/sim/simulation.hpp"

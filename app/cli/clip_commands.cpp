@@ -4,10 +4,10 @@
 #include <cstdio>
 #include <string>
 
-#include "app/cli.hpp"
-#include "app/commands.hpp"
-#include "app/files.hpp"
-#include "app/json.hpp"
+#include "app/cli/cli.hpp"
+#include "app/cli/commands.hpp"
+#include "app/io/files.hpp"
+#include "app/io/json.hpp"
 #include "runtime/formats/asf_amc.hpp"
 #include "runtime/formats/bvh.hpp"
 

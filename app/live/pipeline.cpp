@@ -1,4 +1,4 @@
-#include "app/pipeline.hpp"
+#include "app/live/pipeline.hpp"
 
 #include <fmt/format.h>
 #include <poll.h>
@@ -9,13 +9,13 @@
 #include <stdexcept>
 #include <thread>
 
-#include "app/clock.hpp"
-#include "app/config.hpp"
-#include "app/config_watcher.hpp"
-#include "app/files.hpp"
-#include "app/graph_files.hpp"
-#include "app/realtime.hpp"
-#include "app/replay.hpp"
+#include "app/live/clock.hpp"
+#include "app/config/config.hpp"
+#include "app/live/config_watcher.hpp"
+#include "app/io/files.hpp"
+#include "app/graph/graph_files.hpp"
+#include "app/live/realtime.hpp"
+#include "app/eval/replay.hpp"
 #include "input/input_thread.hpp"
 #include "render_es/interpolate.hpp"
 #include "render_es/view.hpp"

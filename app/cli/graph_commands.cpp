@@ -10,15 +10,15 @@
 #include <cstdio>
 #include <set>
 
-#include "app/cli.hpp"
-#include "app/config.hpp"
-#include "app/default_graph.hpp"
-#include "app/embedded.hpp"
-#include "app/files.hpp"
+#include "app/cli/cli.hpp"
+#include "app/config/config.hpp"
+#include "app/graph/default_graph.hpp"
+#include "app/config/embedded.hpp"
+#include "app/io/files.hpp"
 #include "render_es/image.hpp"
-#include "app/graph_files.hpp"
-#include "app/graph_rebuild.hpp"
-#include "app/json.hpp"
+#include "app/graph/graph_files.hpp"
+#include "app/graph/graph_rebuild.hpp"
+#include "app/io/json.hpp"
 #include "graph_builder/graph_builder.hpp"
 #include "render_es/image.hpp"
 #include "runtime/formats/bvh.hpp"
@@ -38,7 +38,7 @@ struct GraphBuildCommandOptions {
     std::string dot_file;
     int threads = 0;
     bool json = false;
-    bool default_graph = false;  // --default: the embedded default graph (app/default_graph.hpp)
+    bool default_graph = false;  // --default: the embedded default graph (app/graph/default_graph.hpp)
 };
 
 struct GraphInfoOptions {

@@ -1,4 +1,4 @@
-#include "app/realtime.hpp"
+#include "app/live/realtime.hpp"
 
 #include <pthread.h>
 #include <sched.h>

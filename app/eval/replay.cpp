@@ -1,4 +1,4 @@
-#include "app/replay.hpp"
+#include "app/eval/replay.hpp"
 
 #include <fmt/format.h>
 
@@ -6,9 +6,9 @@
 #include <memory>
 #include <stdexcept>
 
-#include "app/config.hpp"
-#include "app/files.hpp"
-#include "app/graph_files.hpp"
+#include "app/config/config.hpp"
+#include "app/io/files.hpp"
+#include "app/graph/graph_files.hpp"
 #include "runtime/formats/bvh.hpp"
 
 namespace marionette {

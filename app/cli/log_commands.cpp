@@ -1,15 +1,15 @@
 // `marionette record` and `marionette replay`.
 #include <fmt/format.h>
 
-#include "app/cli.hpp"
-#include "app/commands.hpp"
-#include "app/config.hpp"
-#include "app/files.hpp"
-#include "app/graph_files.hpp"
-#include "app/graph_rebuild.hpp"
-#include "app/json.hpp"
-#include "app/program_source.hpp"
-#include "app/replay.hpp"
+#include "app/cli/cli.hpp"
+#include "app/cli/commands.hpp"
+#include "app/config/config.hpp"
+#include "app/io/files.hpp"
+#include "app/graph/graph_files.hpp"
+#include "app/graph/graph_rebuild.hpp"
+#include "app/io/json.hpp"
+#include "app/config/program_source.hpp"
+#include "app/eval/replay.hpp"
 
 namespace marionette {
 

@@ -1,4 +1,4 @@
-#include "app/graph_files.hpp"
+#include "app/graph/graph_files.hpp"
 
 #include <cerrno>
 #include <cstring>
@@ -8,9 +8,9 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "app/config.hpp"
-#include "app/default_graph.hpp"
-#include "app/files.hpp"
+#include "app/config/config.hpp"
+#include "app/graph/default_graph.hpp"
+#include "app/io/files.hpp"
 
 namespace marionette {
 

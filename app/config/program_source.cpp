@@ -1,6 +1,6 @@
-#include "app/program_source.hpp"
+#include "app/config/program_source.hpp"
 
-#include "app/embedded.hpp"
+#include "app/config/embedded.hpp"
 
 namespace marionette {
 

@@ -1,4 +1,4 @@
-#include "app/config_watcher.hpp"
+#include "app/live/config_watcher.hpp"
 
 #include <sys/inotify.h>
 #include <unistd.h>

@@ -5,7 +5,7 @@
 #include <string_view>
 #include <vector>
 
-#include "app/config.hpp"
+#include "app/config/config.hpp"
 #include "render_es/platform.hpp"
 #include "render_es/settings.hpp"
 

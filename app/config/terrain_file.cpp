@@ -1,12 +1,12 @@
-#include "app/terrain_file.hpp"
+#include "app/config/terrain_file.hpp"
 
 #include <charconv>
 #include <cmath>
 #include <fstream>
 #include <sstream>
 
-#include "app/config.hpp"
-#include "app/embedded.hpp"
+#include "app/config/config.hpp"
+#include "app/config/embedded.hpp"
 
 namespace marionette {
 
