@@ -16,6 +16,8 @@ packages=(
   libegl-dev libgles-dev libgbm-dev libdrm-dev libseat-dev libstb-dev libegl-mesa0 libgl1-mesa-dri xvfb xauth
   # motion graph: BLAS for the distance matrix
   libopenblas-dev
+  # structure check (scripts/check_structure.py): function extents
+  universal-ctags
 )
 if [[ "${MARIONETTE_SETUP_CLANG:-0}" == 1 ]]; then packages+=(clang-14); fi
 
