@@ -85,7 +85,6 @@ constexpr std::uint8_t kRotateX = 3;
 
 // ---------------------------------------------------------------- numbers
 
-
 double read_number(const TextLexer& reader, int line, std::string_view token, const std::string& what) {
     double value = 0.0;
     switch (parse_real(token, value)) {
