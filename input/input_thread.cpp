@@ -16,16 +16,6 @@ namespace marionette::input {
 
 namespace {
 constexpr int kBatch = 64;
-
-DeviceFamily family_of(HidFormat f) {
-    switch (f) {
-        case HidFormat::ds4: return DeviceFamily::ds4;
-        case HidFormat::dualsense: return DeviceFamily::dualsense;
-        case HidFormat::switchpro: return DeviceFamily::switchpro;
-        case HidFormat::steamdeck: return DeviceFamily::steamdeck;
-    }
-    return DeviceFamily::evdev;
-}
 }  // namespace
 
 std::unique_ptr<HidTransport> open_first_hid_pad(const std::string& wanted_path, HidFormat& format, std::string& path,

@@ -10,22 +10,14 @@
 #include "app/io/json.hpp"
 #include "runtime/formats/asf_amc.hpp"
 #include "runtime/formats/bvh.hpp"
+#include "runtime/formats/file_names.hpp"
 
 namespace marionette {
 
 namespace {
-std::string extension_of(const std::string& path) {
-    const size_t dot = path.find_last_of('.');
-    const size_t slash = path.find_last_of('/');
-    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return {};
-    std::string ext = path.substr(dot + 1);
-    for (char& c : ext) c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
-    return ext;
-}
-
 // BVH, AMC (with its ASF) or a bare ASF (skeleton only, zero frames).
 Clip load_clip(const ClipOptions& o) {
-    const std::string ext = extension_of(o.file);
+    const std::string ext = lower_extension(o.file);
     if (ext == "bvh") return load_bvh_file(o.file);
     if (ext == "amc") {
         if (o.asf_file.empty()) throw ImportError(o.file, 0, "an AMC file needs its skeleton: add --asf SKELETON.asf");
@@ -42,7 +34,7 @@ Clip load_clip(const ClipOptions& o) {
 }
 
 std::string format_name(const std::string& path) {
-    const std::string ext = extension_of(path);
+    const std::string ext = lower_extension(path);
     return ext == "bvh" ? "bvh" : (ext == "amc" ? "asf/amc" : "asf");
 }
 }  // namespace
