@@ -91,8 +91,10 @@ Simulation::Simulation(const SimConfig& config, const Terrain& terrain) : config
     const Skeleton skeleton = make_puppet_skeleton(config_);
     if (skeleton.joint_count() > kMaxJoints) throw std::invalid_argument("puppet has too many joints");
     idle_clip_ = make_idle_clip(skeleton, config_);
-    walk_clip_ = make_walk_clip(skeleton, config_);
-    clip_data_hash_ = hash_clip(idle_clip_) ^ (hash_clip(walk_clip_) * 0x9E3779B97F4A7C15ull);
+    // The walk clip is built only for this hash, which every input log records:
+    // dropping it refuses every existing log; it goes with the next log-format bump.
+    const Clip walk_clip = make_walk_clip(skeleton, config_);
+    clip_data_hash_ = hash_clip(idle_clip_) ^ (hash_clip(walk_clip) * 0x9E3779B97F4A7C15ull);
     // Tick 0: standing on the terrain at the origin, so even a run of no ticks has a full pose.
     state_.joint_count = skeleton.joint_count();
     rig_ = make_gait_rig(config_);
@@ -233,7 +235,7 @@ void Simulation::pose_gait(Pose& out) const {
                           &rig_,
                           &config_,
                           state_.gait_root.heading,
-                          state_.idle_time,
+                          state_.breath_time,
                           std::span<const int>(puppet.parents),
                           std::span<const vec3>(puppet.rest_offsets),
                           std::span<quat>(out.local_rotations.data(), n),
@@ -251,12 +253,12 @@ void Simulation::step_gait(const TickInput& input, float dt, Pose& out) {
     gait_input.stick_x = static_cast<float>(input.left_x) / kStickScale;
     gait_input.stick_y = static_cast<float>(input.left_y) / kStickScale;
     gait_input.dt = dt;
-    gait_input.breath_time = s.idle_time;
+    gait_input.breath_time = s.breath_time;
     update_gait(s.gait, s.gait_root.position, s.gait_root.heading, s.gait_root.velocity, gait_input, c, rig_, terrain_);
     s.locomotion_blend = clampf(s.gait.speed / c.walk_cycle_speed, 0.0f, 1.0f);
     s.walk_phase = s.gait.cycle_phase;
-    s.idle_time += dt;
-    if (s.idle_time >= c.breath_period_s) s.idle_time -= c.breath_period_s;
+    s.breath_time += dt;
+    if (s.breath_time >= c.breath_period_s) s.breath_time -= c.breath_period_s;
     pose_gait(out);
 }
 
@@ -410,7 +412,7 @@ std::uint64_t hash_state(const PuppetState& s) {
     XXH64_update(h, triggers, sizeof triggers);
     XXH64_update(h, &s.input.buttons, sizeof s.input.buttons);
     const float scalars[8] = {s.root_position.x, s.root_position.y, s.root_position.z, s.velocity.x,
-                              s.velocity.y, s.heading, s.walk_phase, s.idle_time};
+                              s.velocity.y, s.heading, s.walk_phase, s.breath_time};
     hash_floats(h, scalars, 8);
     hash_floats(h, &s.locomotion_blend, 1);
     hash_gait(h, s.gait);
