@@ -67,9 +67,12 @@ int clip_fk_command(const ClipOptions& o) {
     const size_t n = static_cast<size_t>(clip.joint_count());
     std::vector<quat> model_rotations(n);
     std::vector<vec3> model_positions(n);
-    LocalToModelJob fk{clip.skeleton.parents, std::span<const quat>(clip.frame_rotations(o.frame), n),
-                       std::span<const vec3>(clip.frame_translations(o.frame), n), model_rotations, model_positions};
-    fk.run();
+    const LocalToModelJob fk{clip.skeleton.parents,
+                             {std::span<const quat>(clip.frame_rotations(o.frame), n),
+                              std::span<const vec3>(clip.frame_translations(o.frame), n)},
+                             {model_rotations, model_positions}};
+    // The importers validate the skeleton, so this holds for every loaded clip.
+    if (!fk.run()) throw ImportError(o.file, 0, "the skeleton's parents are not in topological order");
     const Skeleton& s = clip.skeleton;
     if (o.json) {
         std::string out = "{\"joints\":[";

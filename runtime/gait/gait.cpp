@@ -788,53 +788,72 @@ void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const
     lean_with_speed(g, c, dt);
 }
 
+namespace {
+bool finite3(vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool positive_length(float metres) { return metres > 0.0f && std::isfinite(metres); }
+
+// Runs an IK job whose inputs GaitPoseJob::validate() vouched for (positive
+// bone lengths, a finite state), so it cannot fail.
+TwoBoneIkResult solve_limb(TwoBoneIkJob ik) {
+    TwoBoneIkResult result;
+    ik.result = &result;
+    expect_job_ran(ik.run());
+    return result;
+}
+}  // namespace
+
 bool GaitPoseJob::validate() const {
     const std::size_t n = static_cast<std::size_t>(kPuppetJointCount);
-    return gait && rig && config && parents.size() == n && rest_offsets.size() == n && local_rotations.size() == n &&
-           local_translations.size() == n && model_rotations.size() >= n && model_positions.size() >= n;
+    if (!gait || !rig || !config || parents.size() != n || rest_offsets.size() != n || !pose.has_joints(n) ||
+        !parents_in_topological_order(parents))
+        return false;
+    const GaitRig& r = *rig;
+    return positive_length(r.thigh) && positive_length(r.shin) && positive_length(r.upper_arm) &&
+           positive_length(r.forearm) && std::isfinite(heading) && finite3(gait->pelvis) &&
+           finite3(gait->feet[0].ankle) && finite3(gait->feet[1].ankle);
 }
 
-void GaitPoseJob::run() const {
+bool GaitPoseJob::run() const {
+    if (!validate()) return false;
     const GaitState& g = *gait;
     const GaitRig& r = *rig;
     const GaitConfig& c = *config;
-    for (std::size_t j = 0; j < local_rotations.size(); ++j) {
-        local_rotations[j] = quat_identity();
-        local_translations[j] = rest_offsets[j];
+    for (std::size_t j = 0; j < pose.local_rotations.size(); ++j) {
+        pose.local_rotations[j] = quat_identity();
+        pose.local_translations[j] = rest_offsets[j];
     }
     const HeadingFrame h = heading_frame(heading);
     const quat yaw = quat_axis_angle(vec3(0.0f, 1.0f, 0.0f), heading);
-    local_rotations[kPelvis] = yaw;
-    local_translations[kPelvis] = g.pelvis;
+    pose.local_rotations[kPelvis] = yaw;
+    pose.local_translations[kPelvis] = g.pelvis;
     // Spine leans into the motion (spread over three joints), breathes when still;
     // neck and head take back half the lean so the gaze stays level.
     const double breath = det::sin(det::kTwoPi * breath_time / c.breath_period_s) * (1.0f - g.activity);
     const quat spine = quat_axis_angle(vec3(1.0f, 0.0f, 0.0f), g.lean / 3.0f - 0.01 * breath);
-    local_rotations[kSpine1] = spine;
-    local_rotations[kSpine2] = spine;
-    local_rotations[kSpine3] = spine;
+    pose.local_rotations[kSpine1] = spine;
+    pose.local_rotations[kSpine2] = spine;
+    pose.local_rotations[kSpine3] = spine;
     const quat head = quat_axis_angle(vec3(1.0f, 0.0f, 0.0f), -0.25 * g.lean + 0.01 * breath);
-    local_rotations[kNeck] = head;
-    local_rotations[kHead] = head;
+    pose.local_rotations[kNeck] = head;
+    pose.local_rotations[kHead] = head;
 
     // Legs: two-bone IK from each hip to its ankle, knees forward.
     const int thighs[2] = {kThighL, kThighR};
     for (int i = 0; i < 2; ++i) {
         const FootState& f = g.feet[static_cast<std::size_t>(i)];
-        TwoBoneIkInput ik;
+        TwoBoneIkJob ik;
         ik.root = g.pelvis + h.left * (side_sign(i) * r.hip_half_width);
         ik.target = f.ankle;
         ik.pole = h.forward;
         ik.upper_length = r.thigh;
         ik.lower_length = r.shin;
-        const TwoBoneIkResult s = solve_two_bone_ik(ik);
+        const TwoBoneIkResult s = solve_limb(ik);
         const std::size_t thigh = static_cast<std::size_t>(thighs[i]);
-        local_rotations[thigh] = quat_normalize(quat_mul(quat_conjugate(yaw), s.upper_rotation));
-        local_rotations[thigh + 1] = quat_normalize(quat_mul(quat_conjugate(s.upper_rotation), s.lower_rotation));
-        local_rotations[thigh + 2] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), f.rotation));
+        pose.local_rotations[thigh] = quat_normalize(quat_mul(quat_conjugate(yaw), s.upper_rotation));
+        pose.local_rotations[thigh + 1] = quat_normalize(quat_mul(quat_conjugate(s.upper_rotation), s.lower_rotation));
+        pose.local_rotations[thigh + 2] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), f.rotation));
     }
-    LocalToModelJob fk{parents, local_rotations, local_translations, model_rotations, model_positions};
-    fk.run();
+    expect_job_ran(LocalToModelJob{parents, pose.local(), pose.model()}.run());
 
     // Arms: the hands follow the blended hand paths, swinging against the legs;
     // elbows point back.
@@ -842,21 +861,21 @@ void GaitPoseJob::run() const {
     const float hang = 0.95f * (r.upper_arm + r.forearm);
     for (int i = 0; i < 2; ++i) {
         const std::size_t clavicle = static_cast<std::size_t>(clavicles[i]);
-        const vec3 shoulder = model_positions[clavicle + 1];
+        const vec3 shoulder = pose.model_positions[clavicle + 1];
         const HermiteSample hand = blended_hand(r, g.run_blend, foot_phase(g.cycle_phase, i));
         const vec3 rest(0.03f, 0.0f, 0.02f);
         const vec3 offset = lerp(rest, hand.position, g.activity);
-        TwoBoneIkInput ik;
+        TwoBoneIkJob ik;
         ik.root = shoulder;
         ik.target = shoulder + h.left * (side_sign(i) * offset.x) + vec3(0.0f, offset.y - hang, 0.0f) + h.forward * offset.z;
         ik.pole = -h.forward + h.left * (side_sign(i) * 0.3f);
         ik.upper_length = r.upper_arm;
         ik.lower_length = r.forearm;
         ik.hinge_sign = -1.0f;
-        const TwoBoneIkResult s = solve_two_bone_ik(ik);
-        const quat clavicle_rotation = model_rotations[clavicle];
-        local_rotations[clavicle + 1] = quat_normalize(quat_mul(quat_conjugate(clavicle_rotation), s.upper_rotation));
-        local_rotations[clavicle + 2] = quat_normalize(quat_mul(quat_conjugate(s.upper_rotation), s.lower_rotation));
+        const TwoBoneIkResult s = solve_limb(ik);
+        const quat clavicle_rotation = pose.model_rotations[clavicle];
+        pose.local_rotations[clavicle + 1] = quat_normalize(quat_mul(quat_conjugate(clavicle_rotation), s.upper_rotation));
+        pose.local_rotations[clavicle + 2] = quat_normalize(quat_mul(quat_conjugate(s.upper_rotation), s.lower_rotation));
         // The wrist follows the hand path's swing direction: the hand trails the
         // motion (follow-through), tilting against the path's velocity along the
         // heading and sideways, by kWristDrag per metre per cycle; at rest it
@@ -866,7 +885,7 @@ void GaitPoseJob::run() const {
         const vec3 drag = h.forward * (-kWristDrag * v.z) + h.left * (-kWristDrag * side_sign(i) * v.x);
         const vec3 hand_down = normalize3(forearm_down + drag, forearm_down);
         const quat hand_rotation = quat_mul(quat_from_to(forearm_down, hand_down), s.lower_rotation);
-        local_rotations[clavicle + 3] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), hand_rotation));
+        pose.local_rotations[clavicle + 3] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), hand_rotation));
     }
     // Only the arms changed since the full pass (hands are leaves; nothing after
     // them hangs off an arm): redo forward kinematics for those six joints, with
@@ -875,10 +894,11 @@ void GaitPoseJob::run() const {
         for (int j = clavicle + 1; j <= clavicle + 3; ++j) {
             const std::size_t k = static_cast<std::size_t>(j);
             const std::size_t p = static_cast<std::size_t>(parents[k]);
-            const quat parent_rotation = model_rotations[p];
-            model_rotations[k] = quat_mul(parent_rotation, local_rotations[k]);
-            model_positions[k] = model_positions[p] + quat_rotate(parent_rotation, local_translations[k]);
+            const quat parent_rotation = pose.model_rotations[p];
+            pose.model_rotations[k] = quat_mul(parent_rotation, pose.local_rotations[k]);
+            pose.model_positions[k] = pose.model_positions[p] + quat_rotate(parent_rotation, pose.local_translations[k]);
         }
+    return true;
 }
 
 }  // namespace marionette

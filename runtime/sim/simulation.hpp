@@ -120,6 +120,11 @@ private:
         std::array<vec3, kMaxJoints> local_translations{};
         std::array<quat, kMaxJoints> model_rotations{};
         std::array<vec3, kMaxJoints> model_positions{};
+        // The first `joints` entries of each array, as the jobs take them.
+        PoseSpans spans(size_t joints) {
+            return {{local_rotations.data(), joints}, {local_translations.data(), joints},
+                    {model_rotations.data(), joints}, {model_positions.data(), joints}};
+        }
     };
     void step_gait(const TickInput& input, float dt, Pose& out);
     void pose_gait(Pose& out) const;

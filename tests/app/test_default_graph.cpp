@@ -27,9 +27,11 @@ std::vector<vec3> model_positions(const Clip& clip, int frame) {
     const size_t J = static_cast<size_t>(clip.joint_count());
     std::vector<quat> mr(J);
     std::vector<vec3> mp(J);
-    LocalToModelJob fk{clip.skeleton.parents, std::span<const quat>(clip.frame_rotations(frame), J),
-                       std::span<const vec3>(clip.frame_translations(frame), J), mr, mp};
-    fk.run();
+    const LocalToModelJob fk{clip.skeleton.parents,
+                             {std::span<const quat>(clip.frame_rotations(frame), J),
+                              std::span<const vec3>(clip.frame_translations(frame), J)},
+                             {mr, mp}};
+    REQUIRE(fk.run());
     return mp;
 }
 
