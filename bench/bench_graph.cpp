@@ -316,7 +316,7 @@ void BM_ControllerCircleActionsCmu16(benchmark::State& state) {
 }
 
 void BM_ControllerCircleActionsDefault(benchmark::State& state) {
-    static const MotionGraph g = build_default_motion_graph(SimConfig{});
+    static const MotionGraph g = build_default_motion_graph(SimConfig{}, GraphBuildConfig{});
     controller_circle_actions(state, g);
 }
 
