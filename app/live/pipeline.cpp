@@ -38,7 +38,7 @@ void SimulationLoop::apply(const SimConfig& config, TickRecord::ConfigSource sou
     // checked when it was decoded, so retune cannot fail here. It copies the
     // configuration into the simulation's; the terrain is structural, so its
     // arrays have the same sizes and the copy reuses their storage.
-    if (!sim_.retune(config).empty()) return;
+    if (!sim_.retune(config).ok()) return;
     ++config_changes_;
     record_.kind = TickRecord::Kind::config_change;
     record_.config_source = source;
@@ -399,21 +399,22 @@ std::string config_diff(const SimConfig& from, const SimConfig& to) {
     return out.empty() ? "no change" : out;
 }
 
-std::string realtime_change(const SimConfig& a, const SimConfig& b) {
+// Ok when the [realtime] thread settings are the same; they apply only at start.
+Outcome realtime_unchanged(const SimConfig& a, const SimConfig& b) {
     const std::int32_t SimConfig::*const keys[] = {&SimConfig::input_priority, &SimConfig::simulation_priority,
                                                    &SimConfig::render_priority, &SimConfig::input_cpu,
                                                    &SimConfig::simulation_cpu, &SimConfig::render_cpu,
                                                    &SimConfig::lock_memory};
     for (auto key : keys)
-        if (a.*key != b.*key) return "realtime (thread settings)";
-    return {};
+        if (a.*key != b.*key) return Outcome::failure("realtime (thread settings)");
+    return Outcome::success();
 }
 
 // The writer's side of live tuning: validate an edit and hand it to the simulation.
 struct LiveTuning {
     std::unique_ptr<ConfigWatcher> watcher;
     SimConfig published;       // the newest configuration handed over
-    // Only its fixed-after-start part is read (motion_source_refusal), so this
+    // Only its fixed-after-start part is read (motion_source_allowed), so this
     // thread may ask it while the simulation thread steps.
     const Simulation* simulation = nullptr;
     std::uint32_t version = 0;
@@ -430,12 +431,12 @@ struct LiveTuning {
             fmt::print(err, "config: {}; keeping the previous configuration\n", e.what());
             return;
         }
-        std::string key = structural_change(published, next);
-        if (key.empty()) key = realtime_change(published, next);
-        if (key.empty() && simulation) key = simulation->motion_source_refusal(next);
-        if (!key.empty()) {
+        Outcome kept = structure_unchanged(published, next);
+        if (kept.ok()) kept = realtime_unchanged(published, next);
+        if (kept.ok() && simulation) kept = simulation->motion_source_allowed(next);
+        if (!kept.ok()) {
             fmt::print(err, "config: {}: {} cannot change while running (restart to apply it); keeping the previous configuration\n",
-                       watcher->path(), key);
+                       watcher->path(), kept.problem());
             return;
         }
         if (serialize_config(next) == serialize_config(published)) return;
@@ -492,8 +493,8 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
     if (!o.watch_config_file.empty()) tuning.watcher = std::make_unique<ConfigWatcher>(o.watch_config_file);
 
     std::string realtime_failed;
-    auto note_failure = [&](const std::string& what) {
-        if (!what.empty()) realtime_failed += (realtime_failed.empty() ? "" : "; ") + what;
+    auto note_failure = [&](const Outcome& applied) {
+        if (!applied.ok()) realtime_failed += (realtime_failed.empty() ? "" : "; ") + applied.problem();
     };
     if (config.lock_memory) note_failure(lock_all_memory());
 
@@ -528,8 +529,8 @@ PipelineResult run_pipeline(const PipelineOptions& o) {
         // The input thread before the simulation thread: a device backend that
         // cannot open its pad fails here, before any tick runs or is recorded.
         if (o.device) {
-            std::string error;
-            if (!device->start(sh.input_ring, *o.device, error)) throw ImportError("--input " + o.device->backend, 0, error);
+            if (const Outcome started = device->start(sh.input_ring, *o.device); !started.ok())
+                throw ImportError("--input " + o.device->backend, 0, started.problem());
             result.input_description = device->backend_description();
         } else {
             in_thread = std::thread(input_thread, std::ref(sh), std::cref(o.script), t0, o.virtual_time);

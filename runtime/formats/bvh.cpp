@@ -629,7 +629,7 @@ Clip import_bvh(std::string_view text, const std::string& file_name) {
     read_motion(cur, h, clip);
     // Holds by construction; kept as a guard so a parser bug surfaces as an
     // error rather than as a clip that breaks its users.
-    if (std::string problem = validate_clip(clip); !problem.empty()) cur.fail(0, "inconsistent clip: " + problem);
+    if (const Outcome valid = validate_clip(clip); !valid.ok()) cur.fail(0, "inconsistent clip: " + valid.problem());
     return clip;
 }
 
@@ -659,8 +659,8 @@ Clip load_bvh_file(const std::string& path) {
 }
 
 std::string export_bvh(const Clip& clip) {
-    if (std::string problem = validate_clip(clip); !problem.empty())
-        throw std::invalid_argument("export_bvh: " + problem);
+    if (const Outcome valid = validate_clip(clip); !valid.ok())
+        throw std::invalid_argument("export_bvh: " + valid.problem());
     const Skeleton& sk = clip.skeleton;
     const auto joints = static_cast<std::size_t>(sk.joint_count());
     for (const std::string& name : sk.joint_names)
