@@ -28,21 +28,17 @@ DeviceFamily family_of(HidFormat f) {
 }
 }  // namespace
 
-std::unique_ptr<HidTransport> open_first_hid_pad(const std::string& wanted_path, HidFormat& format, std::string& path,
-                                                std::string& error) {
+Outcome open_first_hid_pad(const std::string& wanted_path, OpenedHidPad& opened) {
     for (const HidDeviceInfo& p : enumerate_hid_pads())
         if (wanted_path.empty() || p.path == wanted_path) {
-            std::unique_ptr<HidTransport> transport = open_hidapi_transport(p.path);
-            if (!transport) {
-                error = p.path + ": cannot open the hidraw node (permissions? see docs/input.md)";
-                return nullptr;
-            }
-            path = p.path;
-            format = p.format;
-            return transport;
+            opened.transport = open_hidapi_transport(p.path);
+            if (!opened.transport)
+                return Outcome::failure(p.path + ": cannot open the hidraw node (permissions? see docs/input.md)");
+            opened.path = p.path;
+            opened.format = p.format;
+            return Outcome::success();
         }
-    error = wanted_path.empty() ? "no supported HID pad found" : wanted_path + ": not a supported HID pad";
-    return nullptr;
+    return Outcome::failure(wanted_path.empty() ? "no supported HID pad found" : wanted_path + ": not a supported HID pad");
 }
 
 BackendChoice probe_input_backend(const std::string& evdev_dir) {
@@ -53,46 +49,39 @@ BackendChoice probe_input_backend(const std::string& evdev_dir) {
         found.evdev.push_back({e.path, e.vendor_id, e.product_id});
     if (found.hid.empty() && found.evdev.empty()) {
         SdlBackend sdl;
-        std::string error;
-        found.sdl_available = sdl.start("", error);
+        found.sdl_available = sdl.start("").ok();
         found.sdl_joysticks = sdl.joysticks();
     }
     return choose_input_backend(found);
 }
 
-bool InputThread::start(InputRing& ring, const InputThreadOptions& options, std::string& error) {
+Outcome InputThread::start(InputRing& ring, const InputThreadOptions& options) {
     stop();
     options_ = options;
     if (options.backend == "auto") {
         const BackendChoice choice = probe_input_backend(options.evdev_dir);
         kind_ = choice.kind;
         description_ = choice.reason;
-        if (kind_ == BackendKind::none) {
-            error = choice.reason;
-            return false;
-        }
+        if (kind_ == BackendKind::none) return Outcome::failure(choice.reason);
     } else {
         const auto k = backend_from_name(options.backend);
-        if (!k) {
-            error = "--backend " + options.backend + ": expected auto, hidraw, evdev or sdl";
-            return false;
-        }
+        if (!k) return Outcome::failure("--backend " + options.backend + ": expected auto, hidraw, evdev or sdl");
         kind_ = *k;
         description_ = std::string(backend_name(kind_)) + ": chosen on the command line";
     }
     stop_requested_ = false;
-    std::promise<std::string> started;
-    std::future<std::string> result = started.get_future();
+    std::promise<Outcome> started;
+    std::future<Outcome> result = started.get_future();
     thread_ = std::thread([this, &ring, &started] {
         // Each runner opens its backend, reports success or failure through
         // `started` (exactly once), then loops until stop().
         switch (kind_) {
             case BackendKind::evdev: {
                 EvdevBackend backend;
-                std::string err;
-                const bool ok = options_.device_path.empty() ? backend.watch_directory(options_.evdev_dir, err)
-                                                             : backend.open_device(options_.device_path, err);
-                started.set_value(ok ? "" : err);
+                Outcome opened = options_.device_path.empty() ? backend.watch_directory(options_.evdev_dir)
+                                                              : backend.open_device(options_.device_path);
+                const bool ok = opened.ok();
+                started.set_value(std::move(opened));
                 if (!ok) return;
                 running_ = true;
                 backend.set_raw(options_.raw);
@@ -122,25 +111,23 @@ bool InputThread::start(InputRing& ring, const InputThreadOptions& options, std:
             }
             case BackendKind::hidraw: {
                 const HidOpener& open = options_.open_hid ? options_.open_hid : open_first_hid_pad;
-                HidFormat format = HidFormat::ds4;
-                std::string path, err;
-                std::unique_ptr<HidTransport> transport = open(options_.device_path, format, path, err);
-                if (!transport) {
-                    started.set_value(err);
+                OpenedHidPad opened;
+                if (Outcome first = open(options_.device_path, opened); !first.ok()) {
+                    started.set_value(std::move(first));
                     return;
                 }
                 std::optional<HidPad> pad;
-                pad.emplace(*transport, format);
+                pad.emplace(*opened.transport, opened.format);
                 if (!pad->initialise(200)) {
-                    started.set_value(path + ": the pad did not accept its start-up reports");
+                    started.set_value(Outcome::failure(opened.path + ": the pad did not accept its start-up reports"));
                     return;
                 }
-                started.set_value("");
+                started.set_value(Outcome::success());
                 running_ = true;
                 connected_ = true;
                 connects_ = 1;
                 InputRingWriter<InputRing> writer(ring);
-                const FamilyCalibration* cal = &options_.config.family(family_of(format));
+                const FamilyCalibration* cal = &options_.config.family(family_of(opened.format));
                 std::uint64_t rejected_by_earlier_pads = 0;
                 InputSample s;
                 while (!stop_requested_.load(std::memory_order_relaxed)) {
@@ -151,15 +138,14 @@ bool InputThread::start(InputRing& ring, const InputThreadOptions& options, std:
                                              !stop_requested_.load(std::memory_order_relaxed);
                              waited += 10)
                             usleep(10'000);
-                        transport = open(options_.device_path, format, path, err);
-                        if (!transport) continue;
-                        pad.emplace(*transport, format);
+                        if (!open(options_.device_path, opened).ok()) continue;
+                        pad.emplace(*opened.transport, opened.format);
                         if (!pad->initialise(200)) {
                             pad.reset();
-                            transport.reset();
+                            opened.transport.reset();
                             continue;
                         }
-                        cal = &options_.config.family(family_of(format));
+                        cal = &options_.config.family(family_of(opened.format));
                         connected_.store(true, std::memory_order_release);
                         connects_.fetch_add(1);
                         continue;
@@ -181,16 +167,16 @@ bool InputThread::start(InputRing& ring, const InputThreadOptions& options, std:
                         disconnects_.fetch_add(1);
                         rejected_by_earlier_pads += pad->counters().rejected();
                         pad.reset();  // before the transport it reads from
-                        transport.reset();
+                        opened.transport.reset();
                     }
                 }
                 break;
             }
             case BackendKind::sdl: {
                 SdlBackend sdl;
-                std::string err;
-                const bool ok = sdl.start(options_.config.sdl_mapping_file, err);
-                started.set_value(ok ? "" : err);
+                Outcome opened = sdl.start(options_.config.sdl_mapping_file);
+                const bool ok = opened.ok();
+                started.set_value(std::move(opened));
                 if (!ok) return;
                 running_ = true;
                 InputRingWriter<InputRing> writer(ring);
@@ -208,16 +194,13 @@ bool InputThread::start(InputRing& ring, const InputThreadOptions& options, std:
                 }
                 break;
             }
-            case BackendKind::none: started.set_value("no backend"); return;
+            case BackendKind::none: started.set_value(Outcome::failure("no backend")); return;
         }
         running_ = false;
     });
-    error = result.get();
-    if (!error.empty()) {
-        thread_.join();
-        return false;
-    }
-    return true;
+    Outcome opened = result.get();
+    if (!opened.ok()) thread_.join();
+    return opened;
 }
 
 void InputThread::stop() {
