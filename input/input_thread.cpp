@@ -24,21 +24,17 @@ constexpr int kHidReopenPollMs = 10;      // while a hidraw pad is unplugged, st
 
 }  // namespace
 
-std::unique_ptr<HidTransport> open_first_hid_pad(const std::string& wanted_path, HidFormat& format, std::string& path,
-                                                std::string& error) {
+Outcome open_first_hid_pad(const std::string& wanted_path, OpenedHidPad& opened) {
     for (const HidDeviceInfo& p : enumerate_hid_pads())
         if (wanted_path.empty() || p.path == wanted_path) {
-            std::unique_ptr<HidTransport> transport = open_hidapi_transport(p.path);
-            if (!transport) {
-                error = p.path + ": cannot open the hidraw node (permissions? see docs/input.md)";
-                return nullptr;
-            }
-            path = p.path;
-            format = p.format;
-            return transport;
+            opened.transport = open_hidapi_transport(p.path);
+            if (!opened.transport)
+                return Outcome::failure(p.path + ": cannot open the hidraw node (permissions? see docs/input.md)");
+            opened.path = p.path;
+            opened.format = p.format;
+            return Outcome::success();
         }
-    error = wanted_path.empty() ? "no supported HID pad found" : wanted_path + ": not a supported HID pad";
-    return nullptr;
+    return Outcome::failure(wanted_path.empty() ? "no supported HID pad found" : wanted_path + ": not a supported HID pad");
 }
 
 BackendChoice probe_input_backend(const std::string& evdev_dir) {
@@ -49,59 +45,49 @@ BackendChoice probe_input_backend(const std::string& evdev_dir) {
         found.evdev.push_back({e.path, e.vendor_id, e.product_id});
     if (found.hid.empty() && found.evdev.empty()) {
         SdlBackend sdl;
-        std::string error;
-        found.sdl_available = sdl.start("", error);
+        found.sdl_available = sdl.start("").ok();
         found.sdl_joysticks = sdl.joysticks();
     }
     return choose_input_backend(found);
 }
 
-bool InputThread::start(InputRing& ring, const InputThreadOptions& options, std::string& error) {
+Outcome InputThread::start(InputRing& ring, const InputThreadOptions& options) {
     stop();
     options_ = options;
-    if (!choose_backend(error)) return false;
+    if (Outcome chosen = choose_backend(); !chosen.ok()) return chosen;
     stop_requested_ = false;
-    std::promise<std::string> started;
-    std::future<std::string> result = started.get_future();
+    std::promise<Outcome> started;
+    std::future<Outcome> result = started.get_future();
     thread_ = std::thread([this, &ring, &started] { run(ring, started); });
-    error = result.get();
-    if (!error.empty()) {
-        thread_.join();
-        return false;
-    }
-    return true;
+    Outcome outcome = result.get();
+    if (!outcome.ok()) thread_.join();
+    return outcome;
 }
 
 // Sets kind_ and description_ from options_.backend ("auto": probe the devices).
-bool InputThread::choose_backend(std::string& error) {
+Outcome InputThread::choose_backend() {
     if (options_.backend == "auto") {
         const BackendChoice choice = probe_input_backend(options_.evdev_dir);
         kind_ = choice.kind;
         description_ = choice.reason;
-        if (kind_ == BackendKind::none) {
-            error = choice.reason;
-            return false;
-        }
-        return true;
+        if (kind_ == BackendKind::none) return Outcome::failure(choice.reason);
+        return Outcome::success();
     }
     const auto k = backend_from_name(options_.backend);
-    if (!k) {
-        error = "--backend " + options_.backend + ": expected auto, hidraw, evdev or sdl";
-        return false;
-    }
+    if (!k) return Outcome::failure("--backend " + options_.backend + ": expected auto, hidraw, evdev or sdl");
     kind_ = *k;
     description_ = std::string(backend_name(kind_)) + ": chosen on the command line";
-    return true;
+    return Outcome::success();
 }
 
 // The thread's body. Each runner opens its backend, reports through `started`
-// exactly once ("" once running, else why it could not open), then loops until stop().
-void InputThread::run(InputRing& ring, std::promise<std::string>& started) {
+// exactly once (success once running, else why it could not open), then loops until stop().
+void InputThread::run(InputRing& ring, std::promise<Outcome>& started) {
     switch (kind_) {
         case BackendKind::evdev: run_evdev(ring, started); break;
         case BackendKind::hidraw: run_hidraw(ring, started); break;
         case BackendKind::sdl: run_sdl(ring, started); break;
-        case BackendKind::none: started.set_value("no backend"); return;
+        case BackendKind::none: started.set_value(Outcome::failure("no backend")); return;
     }
     running_ = false;
 }
@@ -111,12 +97,12 @@ void InputThread::push_calibrated(InputRingWriter<InputRing>& writer, const Fami
     if (writer.push(to_timed_input(s))) samples_.fetch_add(1, std::memory_order_relaxed);
 }
 
-void InputThread::run_evdev(InputRing& ring, std::promise<std::string>& started) {
+void InputThread::run_evdev(InputRing& ring, std::promise<Outcome>& started) {
     EvdevBackend backend;
-    std::string err;
-    const bool ok = options_.device_path.empty() ? backend.watch_directory(options_.evdev_dir, err)
-                                                 : backend.open_device(options_.device_path, err);
-    started.set_value(ok ? "" : err);
+    Outcome opened = options_.device_path.empty() ? backend.watch_directory(options_.evdev_dir)
+                                                  : backend.open_device(options_.device_path);
+    const bool ok = opened.ok();
+    started.set_value(std::move(opened));
     if (!ok) return;
     running_ = true;
     backend.set_raw(options_.raw);
@@ -144,34 +130,31 @@ void InputThread::run_evdev(InputRing& ring, std::promise<std::string>& started)
 // outlives the pad), the pad's format and calibration.
 struct InputThread::HidSession {
     HidOpener open;
-    HidFormat format = HidFormat::ds4;
-    std::string path, err;
-    std::unique_ptr<HidTransport> transport;
+    OpenedHidPad opened;  // transport, format and node: declared before the pad that reads it
     std::optional<HidPad> pad;
     const FamilyCalibration* cal = nullptr;
     std::uint64_t rejected_by_earlier_pads = 0;
     InputSample sample;
 };
 
-void InputThread::run_hidraw(InputRing& ring, std::promise<std::string>& started) {
+void InputThread::run_hidraw(InputRing& ring, std::promise<Outcome>& started) {
     HidSession hid;
     hid.open = options_.open_hid ? options_.open_hid : HidOpener(open_first_hid_pad);
-    hid.transport = hid.open(options_.device_path, hid.format, hid.path, hid.err);
-    if (!hid.transport) {
-        started.set_value(hid.err);
+    if (Outcome first = hid.open(options_.device_path, hid.opened); !first.ok()) {
+        started.set_value(std::move(first));
         return;
     }
-    hid.pad.emplace(*hid.transport, hid.format);
+    hid.pad.emplace(*hid.opened.transport, hid.opened.format);
     if (!hid.pad->initialise(kHidInitTimeoutMs)) {
-        started.set_value(hid.path + ": the pad did not accept its start-up reports");
+        started.set_value(Outcome::failure(hid.opened.path + ": the pad did not accept its start-up reports"));
         return;
     }
-    started.set_value("");
+    started.set_value(Outcome::success());
     running_ = true;
     connected_ = true;
     connects_ = 1;
     InputRingWriter<InputRing> writer(ring);
-    hid.cal = &options_.config.family(family_of(hid.format));
+    hid.cal = &options_.config.family(family_of(hid.opened.format));
     while (!stopping()) {
         if (hid.pad) read_hid_pad(hid, writer);
         else reopen_hid_pad(hid);
@@ -194,7 +177,7 @@ void InputThread::read_hid_pad(HidSession& hid, InputRingWriter<InputRing>& writ
         disconnects_.fetch_add(1);
         hid.rejected_by_earlier_pads += hid.pad->counters().rejected();
         hid.pad.reset();  // before the transport it reads from
-        hid.transport.reset();
+        hid.opened.transport.reset();
     }
 }
 
@@ -203,24 +186,23 @@ void InputThread::read_hid_pad(HidSession& hid, InputRingWriter<InputRing>& writ
 void InputThread::reopen_hid_pad(HidSession& hid) {
     for (int waited = 0; waited < options_.hid_reopen_interval_ms && !stopping(); waited += kHidReopenPollMs)
         usleep(static_cast<useconds_t>(kHidReopenPollMs) * 1000u);
-    hid.transport = hid.open(options_.device_path, hid.format, hid.path, hid.err);
-    if (!hid.transport) return;
-    hid.pad.emplace(*hid.transport, hid.format);
+    if (!hid.open(options_.device_path, hid.opened).ok()) return;
+    hid.pad.emplace(*hid.opened.transport, hid.opened.format);
     if (!hid.pad->initialise(kHidInitTimeoutMs)) {
         hid.pad.reset();
-        hid.transport.reset();
+        hid.opened.transport.reset();
         return;
     }
-    hid.cal = &options_.config.family(family_of(hid.format));
+    hid.cal = &options_.config.family(family_of(hid.opened.format));
     connected_.store(true, std::memory_order_release);
     connects_.fetch_add(1);
 }
 
-void InputThread::run_sdl(InputRing& ring, std::promise<std::string>& started) {
+void InputThread::run_sdl(InputRing& ring, std::promise<Outcome>& started) {
     SdlBackend sdl;
-    std::string err;
-    const bool ok = sdl.start(options_.config.sdl_mapping_file, err);
-    started.set_value(ok ? "" : err);
+    Outcome opened = sdl.start(options_.config.sdl_mapping_file);
+    const bool ok = opened.ok();
+    started.set_value(std::move(opened));
     if (!ok) return;
     running_ = true;
     InputRingWriter<InputRing> writer(ring);

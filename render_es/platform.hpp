@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "runtime/errors/outcome.hpp"
+
 namespace marionette::render {
 
 // A platform could not be opened (no display, no DRM device, no permission, no
@@ -70,7 +72,7 @@ struct KmsModeRequest {
 struct KmsChoice {
     int connector_index = -1;
     int mode_index = -1;
-    std::string error;             // empty when a connector and mode were chosen
+    Outcome chosen = Outcome::success();  // fails naming what is missing
 };
 
 // Connector: the named one (it must be connected) or the first connected one.

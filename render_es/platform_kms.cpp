@@ -126,9 +126,9 @@ Scanout choose_scanout(int fd, const KmsModeRequest& request, const std::string&
         drmModeFreeConnector(c);
     }
     const KmsChoice choice = choose_kms_mode(s.connectors, request);
-    if (!choice.error.empty()) {
+    if (!choice.chosen.ok()) {
         drmModeFreeResources(res);
-        fail(device + ": " + choice.error);
+        fail(device + ": " + choice.chosen.problem());
     }
     const KmsConnector& chosen = s.connectors[static_cast<size_t>(choice.connector_index)];
     s.connector_id = chosen.id;

@@ -75,22 +75,21 @@ void write_stats_json(const std::string& path, const RunOptions& o, const SimCon
                       "time");
 }
 
-// Why the backend named on the command line has no pad to read (empty: it has
-// one). Checked before the run starts so the error is immediate and exits 2.
-std::string missing_pad(const std::string& backend, const std::string& evdev_dir) {
+// Ok when the backend named on the command line has a pad to read, else why not.
+// Checked before the run starts so the error is immediate and exits 2.
+Outcome find_pad(const std::string& backend, const std::string& evdev_dir) {
     if (backend == "evdev") {
         if (input::enumerate_evdev_gamepads(evdev_dir).empty())
-            return "no gamepad under " + evdev_dir + " (is it plugged in and readable? see `marionette input list`)";
+            return Outcome::failure("no gamepad under " + evdev_dir + " (is it plugged in and readable? see `marionette input list`)");
     } else if (backend == "hidraw") {
         if (input::enumerate_hid_pads().empty())
-            return "no supported HID pad found (see `marionette input list`)";
+            return Outcome::failure("no supported HID pad found (see `marionette input list`)");
     } else if (backend == "sdl") {
         input::SdlBackend sdl;
-        std::string error;
-        if (!sdl.start("", error)) return "SDL2 cannot start: " + error;
-        if (sdl.joysticks() == 0) return "SDL2 sees no joystick";
+        if (const Outcome started = sdl.start(""); !started.ok()) return Outcome::failure("SDL2 cannot start: " + started.problem());
+        if (sdl.joysticks() == 0) return Outcome::failure("SDL2 sees no joystick");
     }
-    return {};
+    return Outcome::success();
 }
 
 // What --input resolved to: "auto" probes for a controller (input/auto_select.hpp)
@@ -116,8 +115,8 @@ InputChoice choose_input(const RunOptions& o, input::InputThreadOptions& device)
         c.use_device = true;
         if (o.fast) throw_fast_needs_script();
         // Asked for by name: no pad is an error now, not a run that idles forever.
-        if (const std::string missing = missing_pad(device.backend, device.evdev_dir); !missing.empty())
-            throw ImportError("--input " + c.input, 0, missing);
+        if (const Outcome found = find_pad(device.backend, device.evdev_dir); !found.ok())
+            throw ImportError("--input " + c.input, 0, found.problem());
     }
     if (c.use_device && o.fast) throw_fast_needs_script();
     if (!o.unplug.empty() && c.input.rfind("sim:", 0) != 0)
@@ -147,16 +146,16 @@ std::string prepare_log_input(const RunOptions& o, const std::string& file, AppC
     config = config_from_text(log.header.config_text, file + " (embedded configuration)");
     if (!o.config_file.empty()) {
         const AppConfig tuned = apply_config_text(config, read_text_file(o.config_file), o.config_file);
-        if (const std::string key = structural_change(config.sim, tuned.sim); !key.empty())
-            throw ConfigError(o.config_file, 0, key, "differs from the log's and cannot change for a live replay");
+        if (const Outcome kept = structure_unchanged(config.sim, tuned.sim); !kept.ok())
+            throw ConfigError(o.config_file, 0, kept.problem(), "differs from the log's and cannot change for a live replay");
         config = tuned;
     }
     SimConfig running = config.sim;
     for (const InputLogConfigChange& change : log.config_changes) {
         const SimConfig next = apply_config_change(running, change.config_text,
                                                    fmt::format("{} (config change before tick {})", file, change.before_tick));
-        if (const std::string key = structural_change(running, next); !key.empty())
-            throw ImportError(file, 0, "recorded configuration change alters " + key + ", which cannot change live");
+        if (const Outcome kept = structure_unchanged(running, next); !kept.ok())
+            throw ImportError(file, 0, "recorded configuration change alters " + kept.problem() + ", which cannot change live");
         p.scheduled_changes.push_back({change.before_tick, next});
         running = next;
     }

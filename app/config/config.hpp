@@ -3,28 +3,25 @@
 // (config/marionette.toml, also compiled into the binary) states every key; a user
 // file overrides only what it names. Errors name file, line, key and what was
 // expected.
-#include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "app/config/app_config.hpp"
+#include "runtime/errors/parse_error.hpp"
 
 namespace marionette {
 
-class ConfigError : public std::runtime_error {
+// A configuration file's error: a ParseError whose subject is the key at fault
+// ("table.key"; empty for the file as a whole).
+class ConfigError : public ParseError {
 public:
     ConfigError(std::string file, int line, std::string key, std::string message)
-        : std::runtime_error(file + (line > 0 ? ":" + std::to_string(line) : std::string()) +
-                             (key.empty() ? std::string() : ": " + key) + ": " + message),
-          file_(std::move(file)), line_(line), key_(std::move(key)) {}
-    const std::string& file() const { return file_; }
-    int line() const { return line_; }
+        : ParseError(std::move(file), line, -1, key, std::move(message)), key_(std::move(key)) {}
     const std::string& key() const { return key_; }
 
 private:
-    std::string file_;
-    int line_;
     std::string key_;
 };
 

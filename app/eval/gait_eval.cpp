@@ -139,17 +139,17 @@ bool foot_in_stance(const PuppetState& s, int foot) {
     return s.gait.feet[static_cast<std::size_t>(foot)].swinging == 0;
 }
 
-std::string gait_metric_non_finite(const GaitMetrics& m) {
+Outcome check_gait_metrics_finite(const GaitMetrics& m) {
     const std::pair<const char*, double> values[] = {{"foot_skate_mm", m.foot_skate_mm},
                                                      {"penetration_mm", m.penetration_mm},
                                                      {"speed_error_pct", m.speed_error_pct},
                                                      {"max_joint_speed_deg_s", m.max_joint_speed_deg_s}};
     for (const auto& [name, value] : values)
-        if (!std::isfinite(value)) return fmt::format("{} is not a finite number ({})", name, value);
-    return {};
+        if (!std::isfinite(value)) return Outcome::failure(fmt::format("{} is not a finite number ({})", name, value));
+    return Outcome::success();
 }
 
-std::string gait_limit_failures(const GaitMetrics& m) {
+Outcome check_gait_limits(const GaitMetrics& m) {
     std::string out;
     auto check = [&](const char* name, double value, double limit) {
         if (!(value < limit)) out += fmt::format("{}{} = {:.3f} (limit < {})", out.empty() ? "" : "; ", name, value, limit);
@@ -158,7 +158,7 @@ std::string gait_limit_failures(const GaitMetrics& m) {
     check("penetration_mm", m.penetration_mm, kMaxPenetrationMm);
     check("speed_error_pct", m.speed_error_pct, kMaxSpeedErrorPct);
     check("max_joint_speed_deg_s", m.max_joint_speed_deg_s, kMaxJointSpeedDegS);
-    return out;
+    return out.empty() ? Outcome::success() : Outcome::failure(out);
 }
 
 namespace {

@@ -85,8 +85,8 @@ ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name,
         while (next_change < log.config_changes.size() && log.config_changes[next_change].before_tick <= k) {
             const SimConfig next = apply_config_change(sim.config(), log.config_changes[next_change].config_text,
                                                        fmt::format("{} (config change before tick {})", log_name, k));
-            if (std::string key = sim.retune(next); !key.empty())
-                throw ImportError(log_name, 0, "recorded configuration change alters " + key + ", which cannot change live");
+            if (const Outcome retuned = sim.retune(next); !retuned.ok())
+                throw ImportError(log_name, 0, "recorded configuration change alters " + retuned.problem() + ", which cannot change live");
             ++result.config_changes;
             ++next_change;
         }

@@ -38,7 +38,7 @@ void SimulationLoop::apply(const SimConfig& config, TickRecord::ConfigSource sou
     // checked when it was decoded, so retune cannot fail here. It copies the
     // configuration into the simulation's; the terrain is structural, so its
     // arrays have the same sizes and the copy reuses their storage.
-    if (!sim_.retune(config).empty()) return;
+    if (!sim_.retune(config).ok()) return;
     ++config_changes_;
     record_.kind = TickRecord::Kind::config_change;
     record_.config_source = source;
@@ -417,7 +417,7 @@ struct LiveTuning {
     std::unique_ptr<ConfigWatcher> watcher;
     SimConfig published;       // the newest configuration handed over
     RealtimeConfig realtime;   // the thread settings the run started with (fixed)
-    // Only its fixed-after-start part is read (motion_source_refusal), so this
+    // Only its fixed-after-start part is read (motion_source_allowed), so this
     // thread may ask it while the simulation thread steps.
     const Simulation* simulation = nullptr;
     std::uint32_t version = 0;
@@ -449,12 +449,12 @@ struct LiveTuning {
             fmt::print(err, "config: {}; keeping the previous configuration\n", e.what());
             return;
         }
-        std::string key = structural_change(published, next.sim);
-        if (key.empty() && !(next.realtime == realtime)) key = "realtime (thread settings)";
-        if (key.empty() && simulation) key = simulation->motion_source_refusal(next.sim);
-        if (!key.empty()) {
+        Outcome kept = structure_unchanged(published, next.sim);
+        if (kept.ok() && !(next.realtime == realtime)) kept = Outcome::failure("realtime (thread settings)");
+        if (kept.ok() && simulation) kept = simulation->motion_source_allowed(next.sim);
+        if (!kept.ok()) {
             fmt::print(err, "config: {}: {} cannot change while running (restart to apply it); keeping the previous configuration\n",
-                       watcher->path(), key);
+                       watcher->path(), kept.problem());
             return;
         }
         // The graph build keys are not the tick's: an edit of only those changes nothing here.

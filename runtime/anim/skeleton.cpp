@@ -10,25 +10,25 @@ int Skeleton::find(std::string_view name) const {
     return -1;
 }
 
-std::string validate_skeleton(const Skeleton& s) {
+Outcome validate_skeleton(const Skeleton& s) {
     const size_t n = s.parents.size();
     if (s.joint_names.size() != n || s.rest_offsets.size() != n)
-        return "joint name, parent and offset arrays differ in size";
-    if (n == 0) return "skeleton has no joints";
+        return Outcome::failure("joint name, parent and offset arrays differ in size");
+    if (n == 0) return Outcome::failure("skeleton has no joints");
     std::map<std::string_view, size_t> seen;
     for (size_t i = 0; i < n; ++i) {
         if (s.parents[i] != kNoParent && (s.parents[i] < 0 || static_cast<size_t>(s.parents[i]) >= i))
-            return "joint '" + s.joint_names[i] + "' has parent index " + std::to_string(s.parents[i]) +
-                   ", which is not an earlier joint";
-        if (s.joint_names[i].empty()) return "joint " + std::to_string(i) + " has an empty name";
+            return Outcome::failure("joint '" + s.joint_names[i] + "' has parent index " +
+                                    std::to_string(s.parents[i]) + ", which is not an earlier joint");
+        if (s.joint_names[i].empty()) return Outcome::failure("joint " + std::to_string(i) + " has an empty name");
         auto [it, inserted] = seen.emplace(s.joint_names[i], i);
-        if (!inserted) return "duplicate joint name '" + s.joint_names[i] + "'";
+        if (!inserted) return Outcome::failure("duplicate joint name '" + s.joint_names[i] + "'");
     }
     if (s.end_site_parents.size() != s.end_site_offsets.size())
-        return "end site parent and offset arrays differ in size";
+        return Outcome::failure("end site parent and offset arrays differ in size");
     for (int p : s.end_site_parents)
-        if (p < 0 || static_cast<size_t>(p) >= n) return "end site has an invalid parent index";
-    return {};
+        if (p < 0 || static_cast<size_t>(p) >= n) return Outcome::failure("end site has an invalid parent index");
+    return Outcome::success();
 }
 
 Pose rest_pose(const Skeleton& s) {

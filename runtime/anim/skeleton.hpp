@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "runtime/anim/pose_spans.hpp"
+#include "runtime/errors/outcome.hpp"
 #include "runtime/math/math.hpp"
 
 namespace marionette {
@@ -26,9 +27,9 @@ struct Skeleton {
     int find(std::string_view name) const;
 };
 
-// Empty string when the skeleton is well formed, otherwise what is wrong
-// (sizes differ, a parent index not before its child, duplicate or empty names).
-std::string validate_skeleton(const Skeleton& skeleton);
+// Ok when the skeleton is well formed, otherwise what is wrong (sizes differ, a
+// parent index not before its child, duplicate or empty names).
+Outcome validate_skeleton(const Skeleton& skeleton);
 
 // A pose is the local transform of every joint: rotation relative to the parent
 // and translation in the parent's frame (the rest offset, unless the source

@@ -823,8 +823,8 @@ Clip import_asf_amc(std::string_view asf_text, const std::string& asf_name, std:
     read_amc(asf, amc_text, amc_name, clip);
     // Holds by construction; a parser bug should surface as an error, not as a
     // clip that breaks its users.
-    if (std::string problem = validate_clip(clip); !problem.empty())
-        throw ImportError(amc_name, 0, "inconsistent clip: " + problem);
+    if (const Outcome valid = validate_clip(clip); !valid.ok())
+        throw ImportError(amc_name, 0, "inconsistent clip: " + valid.problem());
     return clip;
 }
 
@@ -836,8 +836,8 @@ Clip load_asf_amc_files(const std::string& asf_path, const std::string& amc_path
 
 Skeleton import_asf_skeleton(std::string_view asf_text, const std::string& asf_name) {
     AsfSkeleton asf = parse_asf(asf_text, asf_name);
-    if (std::string problem = validate_skeleton(asf.skeleton); !problem.empty())
-        throw ImportError(asf_name, 0, "inconsistent skeleton: " + problem);
+    if (const Outcome valid = validate_skeleton(asf.skeleton); !valid.ok())
+        throw ImportError(asf_name, 0, "inconsistent skeleton: " + valid.problem());
     return std::move(asf.skeleton);
 }
 

@@ -457,8 +457,8 @@ bool valid_export_name(const std::string& name) {
 }
 
 void check_exportable(const Clip& clip) {
-    if (std::string problem = validate_clip(clip); !problem.empty())
-        throw std::invalid_argument("export_bvh: " + problem);
+    if (const Outcome valid = validate_clip(clip); !valid.ok())
+        throw std::invalid_argument("export_bvh: " + valid.problem());
     for (const std::string& name : clip.skeleton.joint_names)
         if (!valid_export_name(name))
             throw std::invalid_argument("export_bvh: joint name " + quote_token(name) +
@@ -632,7 +632,7 @@ Clip import_bvh(std::string_view text, const std::string& file_name) {
     read_motion(cur, h, clip);
     // Holds by construction; kept as a guard so a parser bug surfaces as an
     // error rather than as a clip that breaks its users.
-    if (std::string problem = validate_clip(clip); !problem.empty()) cur.fail(0, "inconsistent clip: " + problem);
+    if (const Outcome valid = validate_clip(clip); !valid.ok()) cur.fail(0, "inconsistent clip: " + valid.problem());
     return clip;
 }
 

@@ -111,8 +111,8 @@ double estimate_graph_facing(const MotionGraph& g, int* samples, double* agreeme
 
 GraphController::GraphController(const MotionGraph& graph, const GraphControllerConfig& config)
     : graph_(graph), config_(config), path_search_(graph, config.transition_weight) {
-    const std::string problem = validate_motion_graph(graph);
-    if (!problem.empty()) throw std::invalid_argument("motion graph: " + problem);
+    if (const Outcome valid = validate_motion_graph(graph); !valid.ok())
+        throw std::invalid_argument("motion graph: " + valid.problem());
     if (graph.nodes.empty() || graph.edges.empty()) throw std::invalid_argument("motion graph has no edges");
     for (size_t n = 0; n < graph.nodes.size(); ++n)
         if (graph.out_edges(static_cast<int>(n)).empty())

@@ -115,45 +115,43 @@ std::int32_t resolve_motion_source(const SimConfig& config, bool graph_attached)
     return kSourceGraph;
 }
 
-std::string structural_change(const SimConfig& c, const SimConfig& next) {
-    if (next.tick_rate_hz != c.tick_rate_hz) return "simulation.tick_rate_hz";
+Outcome structure_unchanged(const SimConfig& c, const SimConfig& next) {
+    if (next.tick_rate_hz != c.tick_rate_hz) return Outcome::failure("simulation.tick_rate_hz");
     const float SimConfig::*const structural[] = {
         &SimConfig::pelvis_height, &SimConfig::hip_width, &SimConfig::thigh_length, &SimConfig::shin_length,
         &SimConfig::ankle_height, &SimConfig::foot_length, &SimConfig::toe_length, &SimConfig::spine_length,
         &SimConfig::neck_length, &SimConfig::head_length, &SimConfig::shoulder_width,
         &SimConfig::upper_arm_length, &SimConfig::forearm_length, &SimConfig::hand_length};
     for (auto field : structural)
-        if (next.*field != c.*field) return "puppet (skeleton proportions)";
-    if (!(next.terrain == c.terrain)) return "terrain";
-    return {};
+        if (next.*field != c.*field) return Outcome::failure("puppet (skeleton proportions)");
+    if (!(next.terrain == c.terrain)) return Outcome::failure("terrain");
+    return Outcome::success();
 }
 
-std::string Simulation::retune(const SimConfig& next) {
-    std::string key = structural_change(config_, next);
-    if (!key.empty()) return key;
-    key = motion_source_refusal(next);
-    if (!key.empty()) return key;
+Outcome Simulation::retune(const SimConfig& next) {
+    if (Outcome kept = structure_unchanged(config_, next); !kept.ok()) return kept;
+    if (Outcome allowed = motion_source_allowed(next); !allowed.ok()) return allowed;
     const std::int32_t source = resolve_motion_source(next, graph_ != nullptr);
     const std::int32_t current = state_.motion_source;
     config_ = next;
     rig_ = make_gait_rig(config_);
     if (source != current) begin_source_change(source);
-    return {};
+    return Outcome::success();
 }
 
-std::string Simulation::motion_source_refusal(const SimConfig& next) const {
+Outcome Simulation::motion_source_allowed(const SimConfig& next) const {
     const bool wants_graph =
         next.motion_source == MotionSourceSetting::graph || next.motion_source == MotionSourceSetting::graph_feet;
     if (!graph_ && wants_graph)
-        return "motion.source (no motion graph is attached: start with --graph, or with this source in the configuration)";
+        return Outcome::failure("motion.source (no motion graph is attached: start with --graph, or with this source in the configuration)");
     const std::int32_t source = resolve_motion_source(next, graph_ != nullptr);
     // Without a shared skeleton the puppet never leaves the family (gait or
     // graph) it started in, so comparing with the start is the same as with now.
     if ((source == kSourceGait) == skeleton_from_graph_ && !graph_matches_puppet_ && graph_)
-        return "motion.source (the motion graph's skeleton is not the puppet's, so gait and graph cannot blend)";
+        return Outcome::failure("motion.source (the motion graph's skeleton is not the puppet's, so gait and graph cannot blend)");
     if (source == kSourceGraphFeet && !foot_rig_.valid)
-        return "motion.source (graph_feet: the motion graph names no foot joints with a knee and a hip)";
-    return {};
+        return Outcome::failure("motion.source (graph_feet: the motion graph names no foot joints with a knee and a hip)");
+    return Outcome::success();
 }
 
 void Simulation::use_motion_graph(std::shared_ptr<const MotionGraph> graph, const GraphControllerConfig& config,

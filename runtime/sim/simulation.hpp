@@ -8,6 +8,7 @@
 #include <string>
 
 #include "runtime/anim/clip.hpp"
+#include "runtime/errors/outcome.hpp"
 #include "runtime/anim/foot_placement.hpp"
 #include "runtime/gait/gait.hpp"
 #include "runtime/graph/graph_controller.hpp"
@@ -81,11 +82,11 @@ public:
 
     // Applies a new configuration at the tick boundary (live tuning). Structural
     // settings (tick rate, puppet proportions) cannot change while running: the
-    // call then changes nothing and returns the name of the first such key. A new
+    // call then changes nothing and fails naming the first such key. A new
     // [motion] source starts a cross-fade; it is refused (named as
     // "motion.source …") when it needs a graph and none is attached, or when it
     // crosses between gait and graph and the graph's skeleton is not the puppet's.
-    std::string retune(const SimConfig& config);
+    Outcome retune(const SimConfig& config);
 
     const PuppetState& state() const { return state_; }
     const SimConfig& config() const { return config_; }
@@ -106,10 +107,10 @@ public:
     bool graph_matches_puppet() const { return graph_matches_puppet_; }
     // Metres per graph unit of the attached graph's translations (1 without one).
     double metres_per_unit() const { return metres_per_unit_; }
-    // Why retune would refuse the [motion] source of `next` ("motion.source (…)"),
-    // or "" when it would take it. Reads only what is fixed once the graph is
+    // Ok when retune would take the [motion] source of `next`, otherwise why not
+    // ("motion.source (…)"). Reads only what is fixed once the graph is
     // attached, so another thread may call it while step() runs.
-    std::string motion_source_refusal(const SimConfig& next) const;
+    Outcome motion_source_allowed(const SimConfig& next) const;
     double tick_seconds() const { return 1.0 / config_.tick_rate_hz; }
     // Hash of the clip data the puppet animates, recorded in input logs.
     std::uint64_t clip_data_hash() const { return clip_data_hash_; }
@@ -154,9 +155,10 @@ private:
 // (`auto` and the graph sources fall back to the gait without one).
 std::int32_t resolve_motion_source(const SimConfig& config, bool graph_attached);
 
-// The first structural setting (one that cannot change while running: tick rate,
-// puppet proportions) that differs between two configurations, or "" when none.
-std::string structural_change(const SimConfig& running, const SimConfig& next);
+// Ok when no structural setting (one that cannot change while running: tick
+// rate, puppet proportions, terrain) differs between two configurations,
+// otherwise a failure naming the first that does.
+Outcome structure_unchanged(const SimConfig& running, const SimConfig& next);
 
 // Sets flush-to-zero / denormals-are-zero on the calling thread, the same way on
 // every thread that simulates (run and replay alike): denormals are slow and a

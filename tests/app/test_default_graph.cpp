@@ -68,8 +68,8 @@ TEST_CASE("default graph: action clips import onto the puppet skeleton and start
         const Clip& clip = clips[i];
         INFO(clip.name);
         CHECK(clip.name == default_action_clip_names()[i]);
-        CHECK(validate_clip(clip).empty());
-        CHECK(offline::skeleton_mismatch(puppet, clip.skeleton).empty());
+        CHECK(validate_clip(clip).ok());
+        CHECK(offline::same_skeleton(puppet, clip.skeleton).ok());
         CHECK(clip.frame_rate == Approx(30.0));
         CHECK(clip.duration() >= 1.0);
         CHECK(clip.duration() <= 3.0);

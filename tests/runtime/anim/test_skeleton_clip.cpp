@@ -11,10 +11,10 @@ using test::chain;
 TEST_CASE("validate_skeleton names what is wrong", "[skeleton]") {
     Skeleton s = chain();
     s.joint_names[2] = "mid";
-    CHECK_THAT(validate_skeleton(s), Catch::Contains("duplicate joint name 'mid'"));
+    CHECK_THAT(validate_skeleton(s).problem(), Catch::Contains("duplicate joint name 'mid'"));
     s = chain();
     s.parents[1] = 2;
-    CHECK_THAT(validate_skeleton(s), Catch::Contains("not an earlier joint"));
+    CHECK_THAT(validate_skeleton(s).problem(), Catch::Contains("not an earlier joint"));
 }
 
 TEST_CASE("clip sampling interpolates and resampling keeps the motion", "[clip]") {
@@ -28,7 +28,7 @@ TEST_CASE("clip sampling interpolates and resampling keeps the motion", "[clip]"
             clip.rotations.push_back(j == 1 ? quat_axis_angle(vec3(0, 0, 1), 0.5 * f) : quat_identity());
             clip.translations.push_back(j == 0 ? vec3(f * 1.0f, 0, 0) : clip.skeleton.rest_offsets[static_cast<size_t>(j)]);
         }
-    REQUIRE(validate_clip(clip).empty());
+    REQUIRE(validate_clip(clip).ok());
     std::vector<quat> r(3);
     std::vector<vec3> t(3);
     sample_clip(clip, 0.05, ClipWrap::clamp, r, t);  // halfway between frames 0 and 1
@@ -44,19 +44,19 @@ TEST_CASE("clip sampling interpolates and resampling keeps the motion", "[clip]"
     CHECK(fine.frame_rate == 40.0);
     CHECK(fine.frame_translations(8)[0].x == Approx(2.0));
     CHECK(fine.frame_translations(1)[0].x == Approx(0.25));
-    CHECK(validate_clip(fine).empty());
+    CHECK(validate_clip(fine).ok());
 }
 
 TEST_CASE("the default puppet has 22 joints and stands on the ground", "[puppet]") {
     const GaitConfig config;
     const Skeleton s = make_puppet_skeleton(config);
-    REQUIRE(validate_skeleton(s).empty());
+    REQUIRE(validate_skeleton(s).ok());
     CHECK(s.joint_count() == kPuppetJointCount);
     CHECK(s.joint_count() == 22);
     const Clip idle = make_idle_clip(s, config);
     const Clip walk = make_walk_clip(s, config);
-    REQUIRE(validate_clip(idle).empty());
-    REQUIRE(validate_clip(walk).empty());
+    REQUIRE(validate_clip(idle).ok());
+    REQUIRE(validate_clip(walk).ok());
     std::vector<quat> mr(22);
     std::vector<vec3> mp(22);
     REQUIRE(LocalToModelJob{s.parents,
