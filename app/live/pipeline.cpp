@@ -689,8 +689,8 @@ private:
         // The input thread before the simulation thread: a device backend that
         // cannot open its pad fails here, before any tick runs or is recorded.
         if (o_.device) {
-            std::string error;
-            if (!device_->start(sh_.input_ring, *o_.device, error)) throw ImportError("--input " + o_.device->backend, 0, error);
+            if (const Outcome started = device_->start(sh_.input_ring, *o_.device); !started.ok())
+                throw ImportError("--input " + o_.device->backend, 0, started.problem());
             result_.input_description = device_->backend_description();
         } else {
             in_thread_ = std::thread(input_thread, std::ref(sh_), std::cref(o_.script), t0, o_.virtual_time);
@@ -731,9 +731,9 @@ private:
                        result_.realtime_warning);
     }
 
-    void note_realtime_failure(const std::string& what) {
-        if (what.empty()) return;
-        result_.realtime_warning += (result_.realtime_warning.empty() ? "" : "; ") + what;
+    void note_realtime_failure(const Outcome& applied) {
+        if (applied.ok()) return;
+        result_.realtime_warning += (result_.realtime_warning.empty() ? "" : "; ") + applied.problem();
     }
 
     // The backend keeps its own counters; the status line reads these.

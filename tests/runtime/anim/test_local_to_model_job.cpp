@@ -57,7 +57,7 @@ TEST_CASE("LocalToModelJob: bad inputs fail validate() and run() writes nothing"
 
 TEST_CASE("forward kinematics of a bent chain", "[skeleton][job]") {
     const Skeleton s = test::chain();
-    REQUIRE(validate_skeleton(s).empty());
+    REQUIRE(validate_skeleton(s).ok());
     Pose pose = rest_pose(s);
     pose.local_rotations[1] = quat_axis_angle(vec3(0, 0, 1), det::kHalfPi);
     std::vector<quat> mr(3);

@@ -29,7 +29,7 @@ void check_same_pose(const std::vector<quat>& r, const std::vector<vec3>& t, con
 
 TEST_CASE("GraphSampleJob: bad inputs fail validate() and run() writes nothing", "[graph][job]") {
     const MotionGraph graph = test::small_graph();
-    REQUIRE(validate_motion_graph(graph).empty());
+    REQUIRE(validate_motion_graph(graph).ok());
     test::SentinelPose out(kJoints), scratch(kJoints);
     const GraphSampleJob valid{&graph, kClipEdge, 1.5f, PlanarTransform{}, scratch.local(), out.local()};
     const auto check_refused = [&](const GraphSampleJob& job) {
