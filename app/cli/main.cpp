@@ -4,6 +4,7 @@
 
 #include "app/cli/cli.hpp"
 #include "app/config/config.hpp"
+#include "app/eval/log_provenance.hpp"
 #include "runtime/errors/import_error.hpp"
 
 int main(int argc, char** argv) {
@@ -23,6 +24,9 @@ int main(int argc, char** argv) {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
+    } catch (const ReplayDesync& e) {
+        fmt::print(stderr, "error: {}\n", e.what());
+        return 3;  // the replay is not exact (docs/determinism.md)
     } catch (const ImportError& e) {
         fmt::print(stderr, "error: {}\n", e.what());
         return 2;

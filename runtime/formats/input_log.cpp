@@ -12,6 +12,7 @@ constexpr size_t kChunkHeaderSize = 4 + 8 + 4 + 4 + 4;  // magic, first tick, ti
 // Payload tags. 0x00–0x7F: a tick record whose low 7 bits say which fields changed.
 constexpr std::uint8_t kTagConfigChange = 0x80;
 constexpr std::uint8_t kTagEnd = 0x81;
+constexpr std::uint8_t kTagCheckpoint = 0x82;  // then the state hash, 8 bytes little-endian
 // Bounds that keep a corrupt length from allocating absurd amounts.
 constexpr std::uint32_t kMaxConfigBytes = 1u << 20;
 constexpr std::uint32_t kMaxChunkPayload = 64u << 20;
@@ -79,6 +80,12 @@ std::vector<std::uint8_t> InputLogEncoder::encode_header(const InputLogHeader& h
     put_u64(out, h.clip_data_hash);
     put_u32(out, static_cast<std::uint32_t>(h.config_text.size()));
     out.insert(out.end(), h.config_text.begin(), h.config_text.end());
+    if (h.version >= 2) {
+        for (const std::string* text : {&h.provenance, &h.motion_data}) {
+            put_u32(out, static_cast<std::uint32_t>(text->size()));
+            out.insert(out.end(), text->begin(), text->end());
+        }
+    }
     put_u32(out, crc32_of(out.data(), out.size()));
     return out;
 }
@@ -117,6 +124,12 @@ void InputLogEncoder::append_config_change(std::string_view text) {
     payload_.push_back(kTagConfigChange);
     put_varint(payload_, text.size());
     payload_.insert(payload_.end(), text.begin(), text.end());
+}
+
+void InputLogEncoder::append_checkpoint(std::uint64_t state_hash) {
+    flush_run();
+    payload_.push_back(kTagCheckpoint);
+    for (int i = 0; i < 8; ++i) payload_.push_back(static_cast<std::uint8_t>(state_hash >> (8 * i)));
 }
 
 void InputLogEncoder::append_end() {
@@ -166,16 +179,29 @@ DecodedInputLog decode_input_log(const std::vector<std::uint8_t>& bytes, const s
     if (std::memcmp(data, kInputLogMagic, 8) != 0)
         throw import_error_at_byte(file, 0, "not a marionette input log (bad magic)");
     log.header.version = get_u32(data + 8);
-    if (log.header.version != kInputLogVersion)
+    if (log.header.version < kOldestInputLogVersion || log.header.version > kInputLogVersion)
         throw import_error_at_byte(file, 8, "unsupported input log version " + std::to_string(log.header.version) +
-                                                " (this build reads version " + std::to_string(kInputLogVersion) + ")");
+                                                " (this build reads versions " + std::to_string(kOldestInputLogVersion) +
+                                                " to " + std::to_string(kInputLogVersion) + ")");
     log.header.tick_rate_hz = get_u32(data + 12);
     log.header.clip_data_hash = get_u64(data + 16);
     const std::uint32_t config_size = get_u32(data + 24);
     if (config_size > kMaxConfigBytes || config_size > size - kFixedHeader - 4)
         throw import_error_at_byte(file, 24, "header's configuration length " + std::to_string(config_size) +
                                                  " exceeds the file");
-    const size_t header_end = kFixedHeader + config_size;
+    size_t header_end = kFixedHeader + config_size;
+    // Version 2: two more length-prefixed texts (provenance, motion data).
+    std::string* extra_texts[] = {&log.header.provenance, &log.header.motion_data};
+    for (int i = 0; i < (log.header.version >= 2 ? 2 : 0); ++i) {
+        if (size - header_end < 8)
+            throw import_error_at_byte(file, static_cast<std::int64_t>(header_end), "header ends inside its provenance fields");
+        const std::uint32_t length = get_u32(data + header_end);
+        if (length > kMaxConfigBytes || length > size - header_end - 8)
+            throw import_error_at_byte(file, static_cast<std::int64_t>(header_end),
+                                       "header text length " + std::to_string(length) + " exceeds the file");
+        extra_texts[i]->assign(reinterpret_cast<const char*>(data + header_end + 4), length);
+        header_end += 4 + length;
+    }
     if (get_u32(data + header_end) != crc32_of(data, header_end))
         throw import_error_at_byte(file, static_cast<std::int64_t>(header_end), "header CRC mismatch: the header is corrupt");
     if (log.header.tick_rate_hz == 0 || log.header.tick_rate_hz > 100000)
@@ -229,6 +255,7 @@ DecodedInputLog decode_input_log(const std::vector<std::uint8_t>& bytes, const s
         // internally inconsistent is dropped whole.
         std::vector<TickInput> chunk_ticks_decoded;
         std::vector<InputLogConfigChange> chunk_changes;
+        std::vector<InputLogCheckpoint> chunk_checkpoints;
         std::uint64_t chunk_ticks = 0;
         bool chunk_complete = false;
         std::string error;
@@ -276,6 +303,13 @@ DecodedInputLog decode_input_log(const std::vector<std::uint8_t>& bytes, const s
                 change.config_text.assign(reinterpret_cast<const char*>(payload + r.pos), static_cast<size_t>(len));
                 r.pos += static_cast<size_t>(len);
                 chunk_changes.push_back(std::move(change));
+            } else if (tag == kTagCheckpoint && log.header.version >= 2) {
+                if (r.size - r.pos < 8) {
+                    error = "truncated checkpoint";
+                    break;
+                }
+                chunk_checkpoints.push_back({log.ticks.size() + chunk_ticks, get_u64(payload + r.pos)});
+                r.pos += 8;
             } else if (tag == kTagEnd) {
                 chunk_complete = true;
             } else {
@@ -289,6 +323,7 @@ DecodedInputLog decode_input_log(const std::vector<std::uint8_t>& bytes, const s
         }
         log.ticks.insert(log.ticks.end(), chunk_ticks_decoded.begin(), chunk_ticks_decoded.end());
         for (InputLogConfigChange& change : chunk_changes) log.config_changes.push_back(std::move(change));
+        log.checkpoints.insert(log.checkpoints.end(), chunk_checkpoints.begin(), chunk_checkpoints.end());
         log.complete = chunk_complete;
         pos += kChunkHeaderSize + payload_size;
         log.good_bytes = static_cast<std::int64_t>(pos);
