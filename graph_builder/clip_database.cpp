@@ -9,6 +9,7 @@
 
 #include "runtime/formats/asf_amc.hpp"
 #include "runtime/formats/bvh.hpp"
+#include "runtime/formats/file_names.hpp"
 #include "runtime/errors/import_error.hpp"
 
 namespace marionette::offline {
@@ -16,15 +17,6 @@ namespace marionette::offline {
 namespace {
 
 int line_of(const toml::node& n) { return static_cast<int>(n.source().begin.line); }
-
-std::string lower_extension(const std::string& path) {
-    const size_t dot = path.find_last_of('.');
-    const size_t slash = path.find_last_of('/');
-    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return {};
-    std::string ext = path.substr(dot + 1);
-    for (char& c : ext) c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
-    return ext;
-}
 
 std::string lower(std::string s) {
     for (char& c : s) c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);

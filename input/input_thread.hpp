@@ -15,6 +15,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <future>
 #include <memory>
 #include <string>
 #include <thread>
@@ -80,6 +81,18 @@ public:
     std::thread& thread() { return thread_; }
 
 private:
+    struct HidSession;
+    bool choose_backend(std::string& error);
+    void run(InputRing& ring, std::promise<std::string>& started);
+    void run_evdev(InputRing& ring, std::promise<std::string>& started);
+    void run_hidraw(InputRing& ring, std::promise<std::string>& started);
+    void run_sdl(InputRing& ring, std::promise<std::string>& started);
+    void read_hid_pad(HidSession& hid, InputRingWriter<InputRing>& writer);
+    void reopen_hid_pad(HidSession& hid);
+    // Calibrates `sample` and pushes it, counting it when the ring takes it.
+    void push_calibrated(InputRingWriter<InputRing>& writer, const FamilyCalibration& cal, InputSample& sample);
+    bool stopping() const { return stop_requested_.load(std::memory_order_relaxed); }
+
     std::thread thread_;
     std::atomic<bool> stop_requested_{false};
     std::atomic<bool> running_{false};

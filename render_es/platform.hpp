@@ -134,6 +134,19 @@ public:
     virtual std::string description() const = 0;
 };
 
+// recover()'s shape on every platform: tear the context down, then build it
+// again; false when building throws.
+template <typename Teardown, typename Build>
+bool rebuild(Teardown&& teardown, Build&& build) {
+    teardown();
+    try {
+        build();
+    } catch (const std::exception&) {
+        return false;
+    }
+    return true;
+}
+
 // Opens the platform options.kind names. Throws PlatformError.
 std::unique_ptr<Platform> open_platform(const PlatformOptions& options);
 std::unique_ptr<Platform> open_headless_platform(const PlatformOptions& options);

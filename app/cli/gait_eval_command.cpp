@@ -27,14 +27,15 @@ struct GaitEvalOptions {
 };
 
 int gait_eval_command(const GaitEvalOptions& o) {
-    SimConfig config = load_config(o.config_file);
+    const AppConfig app = load_config(o.config_file);
+    SimConfig config = app.sim;
     if (!o.terrain.empty()) {
         config.terrain = load_terrain(o.terrain);
         config.terrain_name = o.terrain;
     }
     const StickProgram program = load_program(o.program);
     // No --graph with [motion] source = graph/graph_feet: the embedded default graph.
-    auto graph = load_graph_argument(o.graph_file, config);
+    auto graph = load_graph_argument(o.graph_file, config, app.graph_build);
     const bool with_graph = graph != nullptr;
     const std::string graph_name = o.graph_file.empty() ? std::string("default") : o.graph_file;
     const GaitMetrics m = evaluate_gait(config, program, o.feet_csv, std::move(graph));

@@ -50,16 +50,6 @@ std::string sample_line(const InputSample& s, bool as_json) {
                        s.lx, s.ly, s.rx, s.ry, s.lt, s.rt, names);
 }
 
-DeviceFamily family_of(HidFormat f) {
-    switch (f) {
-        case HidFormat::ds4: return DeviceFamily::ds4;
-        case HidFormat::dualsense: return DeviceFamily::dualsense;
-        case HidFormat::switchpro: return DeviceFamily::switchpro;
-        case HidFormat::steamdeck: return DeviceFamily::steamdeck;
-    }
-    return DeviceFamily::evdev;
-}
-
 // ---- input decode ---------------------------------------------------------------
 
 struct DecodeOptions {

@@ -15,14 +15,15 @@
 namespace marionette {
 
 int record_command(const RecordOptions& o) {
-    const SimConfig config = load_config(o.config_file);
+    const AppConfig app = load_config(o.config_file);
+    const SimConfig& config = app.sim;
     const StickProgram program = load_program(o.program_file);
     const std::vector<TickInput> ticks = render_stick_program(program, config.tick_rate_hz);
 
     set_simulation_float_mode();
     Simulation sim(config);
     InputLogHeader header;
-    if (auto graph = load_graph_argument_rebuilding_stale(o.graph_file, config)) {
+    if (auto graph = load_graph_argument_rebuilding_stale(o.graph_file, config, app.graph_build)) {
         header.motion_data = motion_data_reference(o.graph_file, graph.get());
         attach_motion_graph(sim, std::move(graph), o.graph_file.empty() ? "the default motion graph" : "graph " + o.graph_file);
     }
@@ -64,8 +65,8 @@ int replay_command(const ReplayCommandOptions& o) {
     // bytes than the one recorded, so the log's clip hash would refuse it.
     // The graph the log names (embedded default, or its file by recorded path and
     // content hash) unless --graph says otherwise.
-    options.graph = graph_for_log(log.header, o.log_file, o.graph_file,
-                                  config_from_text(log.header.config_text, o.log_file + " (embedded configuration)"));
+    const AppConfig recorded = config_from_text(log.header.config_text, o.log_file + " (embedded configuration)");
+    options.graph = graph_for_log(log.header, o.log_file, o.graph_file, recorded);
     options.verify_checkpoints = !o.no_verify;
     const ReplayResult r = replay_log(log, o.log_file, options);
     if (o.json) {

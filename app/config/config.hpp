@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include "runtime/sim/sim_config.hpp"
+#include "app/config/app_config.hpp"
 
 namespace marionette {
 
@@ -44,22 +44,30 @@ std::vector<ConfigKeyInfo> config_schema();
 std::string motion_source_name(MotionSourceSetting source);
 
 // Applies the TOML text on top of `base`. Throws ConfigError.
-SimConfig apply_config_text(const SimConfig& base, std::string_view toml_text, const std::string& file_name);
+AppConfig apply_config_text(const AppConfig& base, std::string_view toml_text, const std::string& file_name);
 
 // The built-in default file's text and the configuration it gives.
 std::string_view default_config_text();
-SimConfig default_config();
+AppConfig default_config();
 
 // Defaults, then the user file (if the path is not empty). Throws ConfigError
 // (a missing or unreadable file is one too).
-SimConfig load_config(const std::string& user_file);
+AppConfig load_config(const std::string& user_file);
 
-// The complete effective configuration as TOML, keys in schema order, floats
-// printed so they parse back to the same bits. Logs embed this text.
+// The effective simulation configuration as TOML, keys in schema order, floats
+// printed so they parse back to the same bits: every key the tick reads and no
+// other ([realtime] and the graph build keys are not in it). Logs embed this text.
 std::string serialize_config(const SimConfig& config);
 
-// Parses text written by serialize_config (or any complete or partial config) on
-// top of the defaults, as replay does with a log's embedded configuration.
-SimConfig config_from_text(std::string_view toml_text, const std::string& origin);
+// A log's embedded configuration (text written by serialize_config, or any
+// complete or partial config) on top of the defaults, as replay reads it. Logs
+// written before the tick's keys were split from the rest also carry [realtime]
+// and the [motion_graph] build keys: still accepted, they land in the parts the
+// tick never reads (a `--graph default` replay builds the default graph with them).
+AppConfig config_from_text(std::string_view toml_text, const std::string& origin);
+
+// A log's configuration change (or any TOML text) applied on top of the running
+// simulation configuration; keys of the other parts are accepted and dropped.
+SimConfig apply_config_change(const SimConfig& running, std::string_view toml_text, const std::string& origin);
 
 }  // namespace marionette

@@ -69,15 +69,15 @@ std::string motion_data_reference(const std::string& graph_argument, const Motio
 }
 
 std::shared_ptr<const MotionGraph> graph_for_log(const InputLogHeader& header, const std::string& log_name,
-                                                 const std::string& graph_argument, const SimConfig& config) {
-    if (!graph_argument.empty() || header.motion_data.empty()) return load_graph_argument(graph_argument, config);
+                                                 const std::string& graph_argument, const AppConfig& recorded) {
+    if (!graph_argument.empty() || header.motion_data.empty()) return load_graph_argument(graph_argument, recorded.sim, recorded.graph_build);
     std::istringstream words(header.motion_data);
     std::string kind, hash;
     words >> kind >> hash;
     std::string path;
     std::getline(words >> std::ws, path);
     if (kind == "default-graph") {
-        auto graph = load_graph_argument("default", config);
+        auto graph = load_graph_argument("default", recorded.sim, recorded.graph_build);
         if (motion_graph_content_hash(*graph) != hash)
             throw ImportError(log_name, 0,
                               fmt::format("recorded with the embedded default graph {}, but this build's default graph is {} "

@@ -9,7 +9,7 @@
 
 #include "runtime/formats/input_log.hpp"
 #include "runtime/graph/motion_graph.hpp"
-#include "runtime/sim/sim_config.hpp"
+#include "app/config/app_config.hpp"
 
 namespace marionette {
 
@@ -31,7 +31,7 @@ std::string motion_data_reference(const std::string& graph_argument, const Motio
 // graph to pass. Version 1 logs (no motion_data) fall back to what the log's
 // configuration asks for (the default graph for a graph source).
 std::shared_ptr<const MotionGraph> graph_for_log(const InputLogHeader& header, const std::string& log_name,
-                                                 const std::string& graph_argument, const SimConfig& config);
+                                                 const std::string& graph_argument, const AppConfig& recorded);
 
 // A replay whose state hash differs from a checkpoint the recorder stored.
 class ReplayDesync : public std::runtime_error {

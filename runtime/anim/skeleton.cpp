@@ -40,29 +40,26 @@ Pose rest_pose(const Skeleton& s) {
 
 bool LocalToModelJob::validate() const {
     const size_t n = parents.size();
-    if (local_rotations.size() != n || local_translations.size() != n ||
-        model_rotations.size() < n || model_positions.size() < n)
-        return false;
-    for (size_t i = 0; i < n; ++i)
-        if (parents[i] != kNoParent && (parents[i] < 0 || static_cast<size_t>(parents[i]) >= i))
-            return false;
-    return true;
+    return input.rotations.size() == n && input.translations.size() == n && output.rotations.size() >= n &&
+           output.positions.size() >= n && parents_in_topological_order(parents);
 }
 
-void LocalToModelJob::run() const {
+bool LocalToModelJob::run() const {
+    if (!validate()) return false;
     const size_t n = parents.size();
     for (size_t i = 0; i < n; ++i) {
         const int p = parents[i];
         if (p == kNoParent) {
-            model_rotations[i] = local_rotations[i];
-            model_positions[i] = local_translations[i];
+            output.rotations[i] = input.rotations[i];
+            output.positions[i] = input.translations[i];
         } else {
-            const quat parent_rotation = model_rotations[static_cast<size_t>(p)];
-            model_rotations[i] = quat_mul(parent_rotation, local_rotations[i]);
-            model_positions[i] =
-                model_positions[static_cast<size_t>(p)] + quat_rotate(parent_rotation, local_translations[i]);
+            const quat parent_rotation = output.rotations[static_cast<size_t>(p)];
+            output.rotations[i] = quat_mul(parent_rotation, input.rotations[i]);
+            output.positions[i] =
+                output.positions[static_cast<size_t>(p)] + quat_rotate(parent_rotation, input.translations[i]);
         }
     }
+    return true;
 }
 
 }  // namespace marionette

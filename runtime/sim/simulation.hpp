@@ -46,9 +46,11 @@ struct PuppetState {
     vec3 root_position{0.0f};          // ground point under the pelvis, world metres
     vec2 velocity{0.0f};               // world XZ, m/s
     float heading = 0.0f;              // radians; facing (sin h, 0, cos h)
-    float walk_phase = 0.0f;           // [0, 1) through the walk cycle
-    float idle_time = 0.0f;            // seconds into the idle clip
-    float locomotion_blend = 0.0f;     // 0 idle … 1 walking
+    // walk_phase and locomotion_blend: only hashed (no pose reads them); removing either changes every state
+    // hash and golden, so they stay until the next hash-format bump.
+    float walk_phase = 0.0f;           // [0, 1): gait.cycle_phase after the last gait tick (hashed only, see above)
+    float breath_time = 0.0f;          // s into the breath period: drives the gait's idle breathing
+    float locomotion_blend = 0.0f;     // 0 standing … 1 at walk_cycle_speed or faster (hashed only, see above)
     GaitState gait{};                  // the spline-IK gait's plan (runtime/gait/gait.hpp)
     std::int32_t motion_source = kSourceGait;  // MotionSource now posing the puppet (the target of a fade)
     std::int32_t graph_attached = 0;   // 1: a motion graph is attached (the fields below are then hashed)
@@ -118,6 +120,11 @@ private:
         std::array<vec3, kMaxJoints> local_translations{};
         std::array<quat, kMaxJoints> model_rotations{};
         std::array<vec3, kMaxJoints> model_positions{};
+        // The first `joints` entries of each array, as the jobs take them.
+        PoseSpans spans(size_t joints) {
+            return {{local_rotations.data(), joints}, {local_translations.data(), joints},
+                    {model_rotations.data(), joints}, {model_positions.data(), joints}};
+        }
     };
     void step_gait(const TickInput& input, float dt, Pose& out);
     void pose_gait(Pose& out) const;
@@ -130,8 +137,7 @@ private:
 
     SimConfig config_;
     Terrain terrain_;
-    Clip idle_clip_;
-    Clip walk_clip_;
+    Clip idle_clip_;                   // its skeleton is the puppet's
     std::uint64_t clip_data_hash_ = 0;
     GaitRig rig_;
     std::shared_ptr<const MotionGraph> graph_;

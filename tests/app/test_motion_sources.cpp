@@ -20,7 +20,7 @@ using namespace marionette;
 namespace {
 
 std::shared_ptr<const MotionGraph> default_graph() {
-    static const auto graph = std::make_shared<const MotionGraph>(build_default_motion_graph(SimConfig{}));
+    static const auto graph = std::make_shared<const MotionGraph>(build_default_motion_graph(SimConfig{}, GraphBuildConfig{}));
     return graph;
 }
 

@@ -208,9 +208,11 @@ TEST_CASE("CMU paths reach every label from every kept clip with continuous pose
         std::vector<vec3> a(J), b(J);
         double worst = 0.0;
         for (int f = 0; f < clip.frame_count; ++f) {
-            LocalToModelJob fk{clip.skeleton.parents, std::span<const quat>(clip.frame_rotations(f), J),
-                               std::span<const vec3>(clip.frame_translations(f), J), mr, b};
-            fk.run();
+            const LocalToModelJob fk{clip.skeleton.parents,
+                                     {std::span<const quat>(clip.frame_rotations(f), J),
+                                      std::span<const vec3>(clip.frame_translations(f), J)},
+                                     {mr, b}};
+            REQUIRE(fk.run());
             if (f > 0)
                 for (size_t j = 0; j < J; ++j) worst = std::max(worst, static_cast<double>(glm::length(b[j] - a[j])));
             std::swap(a, b);
@@ -267,7 +269,7 @@ double travel_direction_with_stick_right(const MotionGraph& g, double seconds) {
         GraphControllerInput in;
         in.dt = 1.0f / 60.0f;
         in.stick_x = 1.0f;
-        controller.step(s, in, r, t);
+        REQUIRE(controller.step(s, in, {r, t}));
         if (tick == ticks / 2) half = t[0];
     }
     const vec3 d = t[0] - half;

@@ -25,12 +25,10 @@ ModelPose model_pose(const Clip& clip, int frame) {
     const auto n = static_cast<std::size_t>(clip.joint_count());
     ModelPose pose{std::vector<quat>(n), std::vector<vec3>(n)};
     const LocalToModelJob job{clip.skeleton.parents,
-                              {clip.frame_rotations(frame), n},
-                              {clip.frame_translations(frame), n},
-                              pose.rotations,
-                              pose.positions};
+                              {{clip.frame_rotations(frame), n}, {clip.frame_translations(frame), n}},
+                              {pose.rotations, pose.positions}};
     REQUIRE(job.validate());
-    job.run();
+    REQUIRE(job.run());
     return pose;
 }
 

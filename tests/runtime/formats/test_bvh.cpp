@@ -42,11 +42,12 @@ std::vector<vec3> model_positions(const Clip& clip, int frame) {
     const auto n = static_cast<size_t>(clip.joint_count());
     std::vector<quat> mr(n);
     std::vector<vec3> mp(n);
-    LocalToModelJob job{clip.skeleton.parents,
-                        std::span<const quat>(clip.frame_rotations(frame), n),
-                        std::span<const vec3>(clip.frame_translations(frame), n), mr, mp};
+    const LocalToModelJob job{clip.skeleton.parents,
+                              {std::span<const quat>(clip.frame_rotations(frame), n),
+                               std::span<const vec3>(clip.frame_translations(frame), n)},
+                              {mr, mp}};
     REQUIRE(job.validate());
-    job.run();
+    REQUIRE(job.run());
     return mp;
 }
 

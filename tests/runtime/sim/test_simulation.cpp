@@ -44,7 +44,7 @@ TEST_CASE("the hash covers the state: any change changes it", "[simulation]") {
     s.input.buttons ^= 1;
     CHECK(hash_state(s) != h);
     s = base;
-    s.idle_time += 1e-6f;
+    s.breath_time += 1e-6f;
     CHECK(hash_state(s) != h);
     s = base;
     s.local_rotations[kPuppetJointCount + 3].x = 1.0f;  // past joint_count: not state
