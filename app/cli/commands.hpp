@@ -39,6 +39,7 @@ struct ReplayCommandOptions {
     std::string joints_csv;
     std::string bvh;
     std::string graph_file;                  // --graph: the .mgraph the log was recorded with
+    bool no_verify = false;                  // --no-verify: replay on past a checkpoint mismatch
 };
 int replay_command(const ReplayCommandOptions& options);
 

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "app/cli/cli.hpp"
+#include "app/eval/log_provenance.hpp"
 #include "runtime/errors/parse_error.hpp"
 
 int main(int argc, char** argv) {
@@ -22,6 +23,9 @@ int main(int argc, char** argv) {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
+    } catch (const ReplayDesync& e) {
+        fmt::print(stderr, "error: {}\n", e.what());
+        return 3;  // the replay is not exact (docs/determinism.md)
     } catch (const ParseError& e) {  // a bad file, configuration or option value
         fmt::print(stderr, "error: {}\n", e.what());
         return 2;

@@ -16,6 +16,7 @@
 #include "app/config/config.hpp"
 #include "app/io/files.hpp"
 #include "app/config/render_config.hpp"
+#include "app/eval/log_provenance.hpp"
 #include "app/eval/replay.hpp"
 #include "render_es/image.hpp"
 #include "render_es/interpolate.hpp"
@@ -36,6 +37,7 @@ struct RenderCommandOptions {
     std::string render_config;
     std::string overlays;
     bool no_hud = false;
+    std::string graph_file;  // --graph; default: the graph the log names
 };
 
 bool parse_size(const std::string& text, std::int32_t& w, std::int32_t& h) {
@@ -162,6 +164,8 @@ int render_command(const RenderCommandOptions& o) {
     };
 
     ReplayOptions options;
+    options.graph = graph_for_log(log.header, o.log_file, o.graph_file,
+                                  config_from_text(log.header.config_text, o.log_file + " (embedded configuration)"));
     options.on_tick = [&](const Simulation& sim) {
         const PuppetState& s = sim.state();
         if (!view) {
@@ -213,6 +217,8 @@ void register_render_command(CLI::App& app, int& exit_code) {
         ->check(CLI::ExistingFile);
     cmd->add_option("--overlays", o->overlays, "comma-separated: skeleton,feet,gait,motion_graph,hud");
     cmd->add_flag("--no-hud", o->no_hud, "no text HUD");
+    cmd->add_option("--graph", o->graph_file,
+                    "the motion graph (.mgraph, or default) the log was recorded with (default: the one the log names)");
     on_parsed(cmd, exit_code, [o] { return render_command(*o); });
 }
 

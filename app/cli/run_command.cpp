@@ -278,6 +278,7 @@ int run_command(const RunOptions& o) {
     p.config = config.sim;
     p.realtime = config.realtime;
     p.graph = load_graph_argument_rebuilding_stale(o.graph_file, config.sim, config.graph_build);
+    p.graph_argument = o.graph_file;
     p.virtual_time = o.fast;
     p.record_file = o.record_file;
     p.trace_file = o.trace_file;

@@ -1,5 +1,7 @@
 #include "app/eval/replay.hpp"
 
+#include "app/eval/log_provenance.hpp"
+
 #include <fmt/format.h>
 
 #include <cstdio>
@@ -41,6 +43,28 @@ std::string trace_csv_row(std::uint64_t tick, std::uint64_t state_hash, const ve
     return fmt::format("{},{:016x},{},{},{}\n", tick, state_hash, root.x, root.y, root.z);
 }
 
+namespace {
+
+// Checks the checkpoints recorded after `ticks_stepped` ticks.
+void verify_checkpoints(const DecodedInputLog& log, const std::string& log_name, std::uint64_t ticks_stepped,
+                        const PuppetState& state, const ReplayOptions& options, size_t& next, ReplayResult& result) {
+    for (; next < log.checkpoints.size() && log.checkpoints[next].after_ticks <= ticks_stepped; ++next) {
+        const InputLogCheckpoint& c = log.checkpoints[next];
+        if (!options.verify_checkpoints || c.after_ticks != ticks_stepped) continue;
+        const std::uint64_t hash = hash_state(state);
+        if (hash != c.state_hash)
+            throw ReplayDesync(ticks_stepped,
+                               fmt::format("{}: replay diverged from the recording at tick {}: state hash {:016x}, the log "
+                                           "says {:016x}; recorded by: {}; this build: {} (--no-verify replays on regardless)",
+                                           log_name, ticks_stepped, hash, c.state_hash,
+                                           log.header.provenance.empty() ? std::string("(not recorded)") : log.header.provenance,
+                                           build_provenance()));
+        ++result.checkpoints_verified;
+    }
+}
+
+}  // namespace
+
 ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name, const ReplayOptions& options) {
     const SimConfig config = config_from_text(log.header.config_text, log_name + " (embedded configuration)").sim;
     if (static_cast<std::uint32_t>(config.tick_rate_hz) != log.header.tick_rate_hz)
@@ -79,6 +103,7 @@ ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name,
     ReplayResult result;
     if (options.keep_tick_hashes) result.tick_hashes.reserve(log.ticks.size());
     size_t next_change = 0;
+    size_t next_checkpoint = 0;
     vec3 previous_root = sim.state().root_position;
     bool keep_going = !options.on_tick || options.on_tick(sim);
     for (size_t k = 0; k < log.ticks.size() && keep_going; ++k) {
@@ -92,6 +117,7 @@ ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name,
         }
         sim.step(log.ticks[k]);
         const PuppetState& s = sim.state();
+        verify_checkpoints(log, log_name, k + 1, s, options, next_checkpoint, result);
         const vec3 d = s.root_position - previous_root;
         result.distance_m += std::sqrt(static_cast<double>(d.x) * d.x + static_cast<double>(d.z) * d.z);
         previous_root = s.root_position;

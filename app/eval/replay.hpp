@@ -16,6 +16,9 @@ struct ReplayOptions {
     std::string joints_csv;     // per tick: every joint's world position
     std::string bvh;            // the performed motion as a BVH animation
     bool keep_tick_hashes = false;
+    // Compare the state hash with every checkpoint the log holds (version 2 logs)
+    // and throw ReplayDesync (app/eval/log_provenance.hpp) at the first mismatch.
+    bool verify_checkpoints = true;
     std::shared_ptr<const MotionGraph> graph;  // --graph: drive the puppet from this graph
     // Called with the simulation at its starting state and after every tick
     // (`marionette render` draws frames from it). Returning false stops the replay.
@@ -30,10 +33,12 @@ struct ReplayResult {
     double distance_m = 0.0;                 // path length of the root on the ground
     vec3 final_root_position{0.0f};
     int config_changes = 0;
+    int checkpoints_verified = 0;
 };
 
 // Throws ConfigError/ImportError when the log's configuration or clip data do not
-// match this build, std::runtime_error when an output cannot be written.
+// match this build, ReplayDesync when a checkpoint's state hash differs,
+// std::runtime_error when an output cannot be written.
 ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name, const ReplayOptions& options);
 
 // Per-tick CSV rows shared by `run --trace` and `replay --trace`, so the two are

@@ -26,6 +26,7 @@ public:
 
     void append_tick(const TickInput& input) { encoder_.append_tick(input); }
     void append_config_change(const std::string& text) { encoder_.append_config_change(text); }
+    void append_checkpoint(std::uint64_t state_hash) { encoder_.append_checkpoint(state_hash); }
     std::uint32_t pending_ticks() const { return encoder_.pending_ticks(); }
     // Ends the current chunk and writes it to the file (and the OS).
     void flush();

@@ -13,6 +13,7 @@
 #include "app/config/config.hpp"
 #include "app/live/config_watcher.hpp"
 #include "app/io/files.hpp"
+#include "app/eval/log_provenance.hpp"
 #include "app/graph/graph_files.hpp"
 #include "app/live/realtime.hpp"
 #include "app/eval/replay.hpp"
@@ -483,6 +484,8 @@ public:
             header.tick_rate_hz = static_cast<std::uint32_t>(o.config.tick_rate_hz);
             header.clip_data_hash = sim.clip_data_hash();
             header.config_text = serialize_config(o.config);
+            header.provenance = build_provenance();
+            header.motion_data = motion_data_reference(o.graph_argument, o.graph.get());
             log_ = std::make_unique<InputLogFile>(o.record_file, header);
         }
         if (!o.trace_file.empty()) {
@@ -521,7 +524,10 @@ public:
     }
 
     void close() {
-        if (log_) log_->close();
+        if (log_) {
+            if (ticks_since_checkpoint_ > 0) log_->append_checkpoint(last_hash_);  // the state after the last tick
+            log_->close();
+        }
         if (trace_ && std::fclose(trace_.release()) != 0) throw std::runtime_error(o_.trace_file + ": write failed");
     }
 
@@ -540,6 +546,9 @@ private:
     void write_tick(const TickRecord& r, const vec3& root) {
         if (log_) {
             log_->append_tick(r.input);
+            last_hash_ = r.hash;
+            ticks_since_checkpoint_ = r.tick % kCheckpointIntervalTicks;
+            if (ticks_since_checkpoint_ == 0) log_->append_checkpoint(r.hash);
             if (log_->pending_ticks() >= flush_ticks_) {
                 log_->flush();  // a chunk per 250 ms of ticks: kill -9 loses at most that
                 last_flush_ = monotonic_ns();
@@ -578,6 +587,8 @@ private:
     const int tick_rate_hz_;
     const std::uint32_t flush_ticks_;
     std::unique_ptr<InputLogFile> log_;
+    std::uint64_t last_hash_ = 0;               // the state after the newest tick logged
+    std::uint64_t ticks_since_checkpoint_ = 0;  // ticks logged after the newest checkpoint
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> trace_{nullptr, &std::fclose};
     SimConfig logged_config_;  // the configuration the last change notice left in force
     vec3 previous_root_;

@@ -213,6 +213,7 @@ struct PipelineOptions {
     std::vector<ScheduledConfigChange> scheduled_changes;
     std::uint64_t total_ticks = 0;
     std::shared_ptr<const MotionGraph> graph;  // drive the puppet from this graph (null: the gait)
+    std::string graph_argument;        // --graph as given: the log names the graph by it
     // No clock: ticks run as fast as the input thread provides samples, each tick
     // waiting for every sample up to its time, so the run is deterministic.
     bool virtual_time = false;

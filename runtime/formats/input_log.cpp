@@ -15,6 +15,7 @@ constexpr size_t kChunkHeaderSize = 4 + 8 + 4 + 4 + 4;  // magic, first tick, ti
 constexpr std::uint8_t kTickRecordTagLimit = 0x80;  // tags below it are tick records
 constexpr std::uint8_t kTagConfigChange = 0x80;
 constexpr std::uint8_t kTagEnd = 0x81;
+constexpr std::uint8_t kTagCheckpoint = 0x82;  // then the state hash, 8 bytes little-endian
 // Bounds that keep a corrupt length from allocating absurd amounts.
 constexpr std::uint32_t kMaxConfigBytes = 1u << 20;
 constexpr std::uint32_t kMaxChunkPayload = 64u << 20;
@@ -82,6 +83,12 @@ std::vector<std::uint8_t> InputLogEncoder::encode_header(const InputLogHeader& h
     put_u64(out, h.clip_data_hash);
     put_u32(out, static_cast<std::uint32_t>(h.config_text.size()));
     out.insert(out.end(), h.config_text.begin(), h.config_text.end());
+    if (h.version >= 2) {
+        for (const std::string* text : {&h.provenance, &h.motion_data}) {
+            put_u32(out, static_cast<std::uint32_t>(text->size()));
+            out.insert(out.end(), text->begin(), text->end());
+        }
+    }
     put_u32(out, crc32_of(out.data(), out.size()));
     return out;
 }
@@ -120,6 +127,12 @@ void InputLogEncoder::append_config_change(std::string_view text) {
     payload_.push_back(kTagConfigChange);
     put_varint(payload_, text.size());
     payload_.insert(payload_.end(), text.begin(), text.end());
+}
+
+void InputLogEncoder::append_checkpoint(std::uint64_t state_hash) {
+    flush_run();
+    payload_.push_back(kTagCheckpoint);
+    for (int i = 0; i < 8; ++i) payload_.push_back(static_cast<std::uint8_t>(state_hash >> (8 * i)));
 }
 
 void InputLogEncoder::append_end() {
@@ -165,6 +178,23 @@ constexpr size_t kFixedHeaderSize = 8 + 4 + 4 + 8 + 4;  // magic, version, tick 
 constexpr size_t kCrcSize = 4;
 constexpr std::uint32_t kMaxTickRateHz = 100000;
 
+// Version 2: the provenance and motion-data texts after the configuration, each
+// a 4-byte length and its bytes. Returns the offset after them (the header CRC).
+size_t decode_header_texts(const std::uint8_t* data, size_t size, const std::string& file, size_t at,
+                           InputLogHeader& header) {
+    for (std::string* text : {&header.provenance, &header.motion_data}) {
+        if (size - at < 4 + kCrcSize)
+            throw import_error_at_byte(file, static_cast<std::int64_t>(at), "header ends inside its provenance fields");
+        const std::uint32_t length = get_u32(data + at);
+        if (length > kMaxConfigBytes || length > size - at - 4 - kCrcSize)
+            throw import_error_at_byte(file, static_cast<std::int64_t>(at),
+                                       "header text length " + std::to_string(length) + " exceeds the file");
+        text->assign(reinterpret_cast<const char*>(data + at + 4), length);
+        at += 4 + length;
+    }
+    return at;
+}
+
 // Reads and checks the header; a bad one throws (nothing can be replayed
 // without it). Returns the offset of the first chunk.
 size_t decode_header(const std::uint8_t* data, size_t size, const std::string& file, InputLogHeader& header) {
@@ -173,16 +203,18 @@ size_t decode_header(const std::uint8_t* data, size_t size, const std::string& f
     if (std::memcmp(data, kInputLogMagic, 8) != 0)
         throw import_error_at_byte(file, 0, "not a marionette input log (bad magic)");
     header.version = get_u32(data + 8);
-    if (header.version != kInputLogVersion)
+    if (header.version < kOldestInputLogVersion || header.version > kInputLogVersion)
         throw import_error_at_byte(file, 8, "unsupported input log version " + std::to_string(header.version) +
-                                                " (this build reads version " + std::to_string(kInputLogVersion) + ")");
+                                                " (this build reads versions " + std::to_string(kOldestInputLogVersion) +
+                                                " to " + std::to_string(kInputLogVersion) + ")");
     header.tick_rate_hz = get_u32(data + 12);
     header.clip_data_hash = get_u64(data + 16);
     const std::uint32_t config_size = get_u32(data + 24);
     if (config_size > kMaxConfigBytes || config_size > size - kFixedHeaderSize - kCrcSize)
         throw import_error_at_byte(file, 24, "header's configuration length " + std::to_string(config_size) +
                                                  " exceeds the file");
-    const size_t header_end = kFixedHeaderSize + config_size;
+    size_t header_end = kFixedHeaderSize + config_size;
+    if (header.version >= 2) header_end = decode_header_texts(data, size, file, header_end, header);
     if (get_u32(data + header_end) != crc32_of(data, header_end))
         throw import_error_at_byte(file, static_cast<std::int64_t>(header_end), "header CRC mismatch: the header is corrupt");
     if (header.tick_rate_hz == 0 || header.tick_rate_hz > kMaxTickRateHz)
@@ -252,6 +284,7 @@ TickInput tick_input_of(const std::int64_t (&f)[kFieldCount]) {
 struct DecodedChunk {
     std::vector<TickInput> ticks;
     std::vector<InputLogConfigChange> config_changes;
+    std::vector<InputLogCheckpoint> checkpoints;
     bool complete = false;  // it holds the end marker
 };
 
@@ -285,9 +318,18 @@ ChunkDefect decode_config_change(Reader& r, std::uint64_t before_tick, DecodedCh
     return std::nullopt;
 }
 
-// A chunk's records (tick records, configuration changes, the end marker),
-// whose ticks must add up to what its header states.
-ChunkDefect decode_chunk_payload(const std::uint8_t* payload, const ChunkHeader& header, DecodedChunk& out) {
+// A checkpoint record after its tag (version 2): the state hash after every tick before it.
+ChunkDefect decode_checkpoint(Reader& r, std::uint64_t after_ticks, DecodedChunk& out) {
+    if (r.size - r.pos < 8) return "truncated checkpoint";
+    out.checkpoints.push_back({after_ticks, get_u64(r.data + r.pos)});
+    r.pos += 8;
+    return std::nullopt;
+}
+
+// A chunk's records (tick records, configuration changes, checkpoints, the end
+// marker), whose ticks must add up to what its header states.
+ChunkDefect decode_chunk_payload(const std::uint8_t* payload, const ChunkHeader& header, std::uint32_t version,
+                                 DecodedChunk& out) {
     Reader r{payload, header.payload_size};
     std::int64_t fields[kFieldCount] = {0, 0, 0, 0, 0, 0, 0};  // the delta base starts at zero in each chunk
     while (r.pos < r.size) {
@@ -296,6 +338,7 @@ ChunkDefect decode_chunk_payload(const std::uint8_t* payload, const ChunkHeader&
         if (out.complete) defect = "data after the end marker";
         else if (tag < kTickRecordTagLimit) defect = decode_tick_record(tag, r, fields, header.ticks - out.ticks.size(), out);
         else if (tag == kTagConfigChange) defect = decode_config_change(r, header.first_tick + out.ticks.size(), out);
+        else if (tag == kTagCheckpoint && version >= 2) defect = decode_checkpoint(r, header.first_tick + out.ticks.size(), out);
         else if (tag == kTagEnd) out.complete = true;
         else defect = "unknown record tag " + std::to_string(tag);
         if (defect) return defect;
@@ -317,7 +360,7 @@ DecodedInputLog decode_input_log(const std::vector<std::uint8_t>& bytes, const s
         DecodedChunk chunk;
         ChunkDefect defect = log.complete ? ChunkDefect("data after the end marker")
                                           : read_chunk_header(data, size, pos, log.ticks.size(), header);
-        if (!defect) defect = decode_chunk_payload(data + pos + kChunkHeaderSize, header, chunk);
+        if (!defect) defect = decode_chunk_payload(data + pos + kChunkHeaderSize, header, log.header.version, chunk);
         if (defect) {
             log.warning = file + ": input log truncated or corrupt at byte " + std::to_string(pos) + ": " + *defect +
                           "; replaying the " + std::to_string(log.ticks.size()) + " ticks before it";
@@ -325,6 +368,7 @@ DecodedInputLog decode_input_log(const std::vector<std::uint8_t>& bytes, const s
         }
         log.ticks.insert(log.ticks.end(), chunk.ticks.begin(), chunk.ticks.end());
         for (InputLogConfigChange& change : chunk.config_changes) log.config_changes.push_back(std::move(change));
+        log.checkpoints.insert(log.checkpoints.end(), chunk.checkpoints.begin(), chunk.checkpoints.end());
         log.complete = chunk.complete;
         pos += kChunkHeaderSize + header.payload_size;
         log.good_bytes = static_cast<std::int64_t>(pos);

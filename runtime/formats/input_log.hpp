@@ -14,7 +14,10 @@
 
 namespace marionette {
 
-inline constexpr std::uint32_t kInputLogVersion = 1;
+// Version 2 adds the provenance and motion-data lines to the header and state-hash
+// checkpoints to the chunks; version 1 logs still decode (without them).
+inline constexpr std::uint32_t kInputLogVersion = 2;
+inline constexpr std::uint32_t kOldestInputLogVersion = 1;
 // PNG-style magic: a high byte, a name, then CR LF ^Z LF so text-mode mangling shows.
 inline constexpr unsigned char kInputLogMagic[8] = {0x89, 'M', 'L', 'G', '\r', '\n', 0x1a, '\n'};
 
@@ -23,7 +26,22 @@ struct InputLogHeader {
     std::uint32_t tick_rate_hz = 240;
     std::uint64_t clip_data_hash = 0;
     std::string config_text;  // the effective configuration, TOML
+    // Version 2: what recorded the log ("marionette 0.1.0; GCC 12.2.0; x86_64; ..."),
+    // named when a replay diverges from it.
+    std::string provenance;
+    // Version 2: the motion data the log needs besides the build itself: "" (the
+    // gait only), "default-graph HASH" (the embedded default graph) or
+    // "graph-file HASH PATH" (a .mgraph file; HASH is the XXH64 of its bytes, hex).
+    std::string motion_data;
 };
+
+// A state-hash checkpoint: hash_state() after `after_ticks` ticks were stepped.
+struct InputLogCheckpoint {
+    std::uint64_t after_ticks = 0;
+    std::uint64_t state_hash = 0;
+};
+// The recorders write a checkpoint every this many ticks (1 s at 240 Hz) and one at the end.
+inline constexpr std::uint64_t kCheckpointIntervalTicks = 240;
 
 // A configuration change recorded in the log: it takes effect before the tick
 // with index `before_tick` (0-based), i.e. at a tick boundary.
@@ -41,6 +59,8 @@ public:
     void reserve(size_t payload_bytes) { payload_.reserve(payload_bytes); }
     void append_tick(const TickInput& input);
     void append_config_change(std::string_view config_text);
+    // The state hash after every tick appended so far (version 2 logs).
+    void append_checkpoint(std::uint64_t state_hash);
     // Marks a cleanly finished log; readers warn when it is missing.
     void append_end();
 
@@ -68,6 +88,7 @@ struct DecodedInputLog {
     InputLogHeader header;
     std::vector<TickInput> ticks;
     std::vector<InputLogConfigChange> config_changes;  // in tick order
+    std::vector<InputLogCheckpoint> checkpoints;       // in tick order (version 2)
     bool complete = false;         // an end marker was read
     // Non-empty when the log is truncated, corrupt or lacks its end marker: says at
     // which byte offset and why; ticks hold everything up to the last good chunk.

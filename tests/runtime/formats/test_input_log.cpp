@@ -150,3 +150,65 @@ TEST_CASE("a log without its end marker says so", "[input_log]") {
     CHECK_THAT(log.warning, Catch::Contains("no end marker"));
     CHECK(log.ticks.size() == 1);
 }
+
+// ---- version 2: provenance, motion data, state-hash checkpoints ------------------
+
+TEST_CASE("version 2 logs carry provenance, motion data and checkpoints at their ticks", "[input_log][checkpoint]") {
+    InputLogHeader h = header();
+    h.provenance = "marionette 0.1.0; GCC 12.2.0; x86_64; RelWithDebInfo";
+    h.motion_data = "graph-file 0123456789abcdef /tmp/my graph.mgraph";
+    const std::vector<TickInput> ticks = varied_ticks(1000, 3);
+    std::vector<std::uint8_t> out = InputLogEncoder::encode_header(h);
+    InputLogEncoder encoder;
+    std::vector<InputLogCheckpoint> written;
+    for (std::size_t k = 0; k < ticks.size(); ++k) {
+        encoder.append_tick(ticks[k]);
+        if ((k + 1) % kCheckpointIntervalTicks == 0 || k + 1 == ticks.size()) {
+            written.push_back({k + 1, 0x9e37'79b9'7f4a'7c15ull * (k + 1)});
+            encoder.append_checkpoint(written.back().state_hash);
+        }
+        if (encoder.pending_ticks() >= 100) encoder.finish_chunk(out);  // checkpoints straddle chunk ends
+    }
+    encoder.append_end();
+    encoder.finish_chunk(out);
+    const DecodedInputLog log = decode_input_log(out, "v2.mlog");
+    REQUIRE(log.warning.empty());
+    CHECK(log.header.version == 2);
+    CHECK(log.header.provenance == h.provenance);
+    CHECK(log.header.motion_data == h.motion_data);
+    CHECK(log.ticks == ticks);
+    REQUIRE(log.checkpoints.size() == written.size());
+    for (std::size_t i = 0; i < written.size(); ++i) {
+        CHECK(log.checkpoints[i].after_ticks == written[i].after_ticks);
+        CHECK(log.checkpoints[i].state_hash == written[i].state_hash);
+    }
+}
+
+TEST_CASE("version 1 logs (no provenance, no checkpoints) still decode", "[input_log][checkpoint]") {
+    InputLogHeader h = header();
+    h.version = 1;
+    h.provenance = "ignored: version 1 has no such field";
+    const std::vector<TickInput> ticks = varied_ticks(600, 5);
+    const std::vector<std::uint8_t> bytes = encode_input_log(h, ticks, 60);
+    CHECK(bytes[8] == 1);
+    const DecodedInputLog log = decode_input_log(bytes, "v1.mlog");
+    CHECK(log.warning.empty());
+    CHECK(log.header.version == 1);
+    CHECK(log.header.provenance.empty());
+    CHECK(log.checkpoints.empty());
+    CHECK(log.ticks == ticks);
+}
+
+TEST_CASE("a version 2 header cut inside its provenance fields is refused with the byte", "[input_log][checkpoint]") {
+    InputLogHeader h = header();
+    h.provenance = "marionette test";
+    const std::vector<std::uint8_t> full = encode_input_log(h, varied_ticks(10, 1), 60);
+    const std::size_t provenance_at = 8 + 4 + 4 + 8 + 4 + h.config_text.size();
+    for (std::size_t cut = provenance_at; cut < provenance_at + 4 + h.provenance.size() + 8; ++cut) {
+        const std::vector<std::uint8_t> bytes(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(cut));
+        CHECK_THROWS_AS(decode_input_log(bytes, "cut.mlog"), ImportError);
+    }
+    std::vector<std::uint8_t> long_text = full;
+    long_text[provenance_at + 3] = 0x7f;  // a provenance length far past the file
+    CHECK_THROWS_WITH(decode_input_log(long_text, "len.mlog"), Catch::Contains("exceeds the file"));
+}
