@@ -186,6 +186,9 @@ void BM_ReferenceSpeedup(benchmark::State& state) {
         state.counters["reference_s"] = rs;
         state.counters["speedup"] = rs / ts;
         state.counters["tiled_candidates"] = static_cast<double>(tiled.candidates.size());
+        state.counters["exact_evals"] = static_cast<double>(tiled.exact_evaluations);  // fixed-order re-evaluations
+        state.counters["bound"] = tiled.distance_bound;
+        state.counters["threshold"] = o.threshold;
         state.counters["reference_candidates"] = static_cast<double>(ref.candidates.size());
         state.counters["same_candidates"] = static_cast<double>(same);
         state.counters["identical"] = identical ? 1.0 : 0.0;

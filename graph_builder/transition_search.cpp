@@ -9,7 +9,10 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <thread>
+
+#include "graph_builder/distance_bound.hpp"
 
 namespace marionette::offline {
 
@@ -352,21 +355,25 @@ struct RowWindow {
     double sum_x, sum_z;  // Σ_t centroid of window A
 };
 
-// Distances of one tile row from its window sums, in double, rounded to float
-// once (as the reference's are): dot and cross are the frames' centred terms plus
-// the centroids' part W·(Σ c_a·c_b − ΣA·ΣB / k); D = S_A + S_B − 2Y − 2√(dot² + cross²).
+// Distances of one tile row from its window sums, in double: dot and cross are the
+// frames' centred terms plus the centroids' part W·(Σ c_a·c_b − ΣA·ΣB / k);
+// D = S_A + S_B − 2Y − 2√(dot² + cross²). Not the value kept: what comes out is the
+// interval [lo, hi] (v ∓ bound, through the noise floor, rounded to float) that holds
+// the fixed-order kernel's float for the pair, whatever the BLAS kernel's rounding.
 // col_x, col_z: W/k · Σ_t centroid of each column's window B.
 MARIONETTE_VECTOR_CLONES void window_distances(const double* __restrict sums, std::int32_t dc, RowWindow a, double weight,
-                                               double inv_wk, const double* __restrict col_spread,
+                                               double inv_wk, double bound, const double* __restrict col_spread,
                                                const double* __restrict col_x, const double* __restrict col_z,
-                                               float* __restrict out) {
+                                               float* __restrict lo_out, float* __restrict hi_out) {
     const size_t n = static_cast<size_t>(dc);
     for (size_t c = 0; c < n; ++c) {
         const double dot = sums[c] + (weight * sums[3 * n + c] - (a.sum_x * col_x[c] + a.sum_z * col_z[c]));
         const double cross = sums[n + c] + (weight * sums[4 * n + c] - (a.sum_x * col_z[c] - a.sum_z * col_x[c]));
         const double d = a.spread + col_spread[c] - 2.0 * sums[2 * n + c] - 2.0 * std::sqrt(dot * dot + cross * cross);
         const double v = d * inv_wk;
-        out[c] = static_cast<float>(v > kDistanceNoiseFloor ? v : 0.0);
+        const double lo = v - bound, hi = v + bound;
+        lo_out[c] = static_cast<float>(lo > kDistanceNoiseFloor ? lo : 0.0);
+        hi_out[c] = static_cast<float>(hi > kDistanceNoiseFloor ? hi : 0.0);
     }
 }
 
@@ -391,14 +398,127 @@ struct TileScratch {
     std::vector<double> sums[2];          // window sums of the previous and the current row
     std::vector<double> col_spread, col_x, col_z;  // per column's window B
     std::vector<std::int32_t> invalid_cols;
-    ScratchArray<float> d;                // distances of the tile plus halo
+    ScratchArray<float> d, hi;            // lower and upper bounds of the distances of the tile plus halo
+    std::vector<std::pair<int, int>> undecided;  // neighbours whose order against a cell needs the exact kernel
     std::vector<TransitionCandidate> found;
     std::vector<float> plot;
     std::int64_t evaluations = 0;
+    std::int64_t exact_evaluations = 0;
+    std::int64_t bound_violations = 0;
 };
 
-void run_tile(const FrameFeatures& f, const CandidateSearchOptions& o, std::int32_t i0, std::int32_t i1,
-              std::int32_t j0, std::int32_t j1, TileScratch& s) {
+// Tests only (CandidateSearchOptions::product_noise): every product of a tile moved
+// by a pseudo-random amount within ±scale, fixed per (frame pair, product kind).
+void perturb_products(double* c, std::int32_t row0, std::int32_t nr, std::int32_t col0, std::int32_t nc, double scale,
+                      std::uint64_t kind) {
+    for (std::int32_t r = 0; r < nr; ++r)
+        for (std::int32_t q = 0; q < nc; ++q) {
+            std::uint64_t x = (static_cast<std::uint64_t>(row0 + r) << 32 | static_cast<std::uint32_t>(col0 + q)) ^ (kind << 62);
+            x += 0x9e3779b97f4a7c15ull;  // splitmix64
+            x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+            x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+            x ^= x >> 31;
+            const double unit = static_cast<double>(x >> 11) * 0x1p-52 - 1.0;  // [−1, 1)
+            c[static_cast<size_t>(r) * static_cast<size_t>(nc) + static_cast<size_t>(q)] += scale * unit;
+        }
+}
+
+struct TileSpan {
+    std::int32_t ci0, ci1, cj0, cj1;  // the cells this tile decides
+    std::int32_t ei0, ei1, ej0, ej1;  // the cells it holds (plus the halo)
+};
+
+// The fixed-order kernel's float for a valid pair, checked against the interval the
+// tiled pass gave it: outside it, the error bound is wrong, and the build fails.
+float exact_distance(const FrameFeatures& f, std::int32_t i, std::int32_t j, float lo, float hi, TileScratch& s) {
+    ++s.exact_evaluations;
+    const float x = static_cast<float>(feature_pair_distance(f, i, j));
+    if (!(x >= lo && x <= hi)) ++s.bound_violations;
+    return x;
+}
+
+// The local minima of the tile's cells, decided on the fixed-order kernel's values.
+// The intervals settle most comparisons: a neighbour whose upper bound is below the
+// cell's lower bound is smaller whatever the rounding, one whose lower bound is above
+// the cell's upper bound larger; the cell's own value and those of neighbours whose
+// interval meets it (and is more than one float wide) are computed exactly. So the
+// result is the local-minimum rule on the exact matrix, cell for cell.
+void decide_tile_minima(const FrameFeatures& f, const CandidateSearchOptions& o, const TileSpan& t, TileScratch& s) {
+    const std::int32_t h = o.neighbourhood, N = f.frames;
+    const size_t udc = static_cast<size_t>(t.ej1 - t.ej0);
+    const auto cell = [&](std::int32_t i, std::int32_t j) -> size_t {
+        return static_cast<size_t>(i - t.ei0) * udc + static_cast<size_t>(j - t.ej0);
+    };
+    const auto lo_at = [&](std::int32_t i, std::int32_t j) -> float {
+        return i < t.ei0 || i >= t.ei1 || j < t.ej0 || j >= t.ej1 ? kPairInvalid : s.d[cell(i, j)];  // outside: absent
+    };
+    const auto hi_at = [&](std::int32_t i, std::int32_t j) -> float {
+        return i < t.ei0 || i >= t.ei1 || j < t.ej0 || j >= t.ej1 ? kPairInvalid : s.hi[cell(i, j)];
+    };
+    std::map<std::pair<std::int32_t, std::int32_t>, std::vector<TransitionCandidate>> bridges;
+    const double keep_below = std::max(o.threshold, o.bridge_threshold);
+    for (std::int32_t i = t.ci0; i < t.ci1; ++i) {
+        const float* __restrict row = s.d.data() + cell(i, t.ej0);  // row[j − ej0]: lower bounds
+        const float* __restrict row_hi = s.hi.data() + cell(i, t.ej0);
+        std::int64_t evaluated = 0;  // (a separate branch-free loop: it vectorises)
+        for (std::int32_t c = t.cj0 - t.ej0; c < t.cj1 - t.ej0; ++c) evaluated += row[c] >= 0.0f && row[c] < kPairInvalid;
+        s.evaluations += evaluated;
+        if (o.plot)  // (the picture shows the lower bounds: it is not part of the graph)
+            for (std::int32_t j = t.cj0; j < t.cj1; ++j) {
+                const float v = row[j - t.ej0];
+                if (!(v >= 0.0f && v < kPairInvalid)) continue;
+                const size_t px = static_cast<size_t>(static_cast<std::int64_t>(i) * o.plot_size / N);
+                const size_t py = static_cast<size_t>(static_cast<std::int64_t>(j) * o.plot_size / N);
+                float& pixel = s.plot[px * static_cast<size_t>(o.plot_size) + py];
+                pixel = std::min(pixel, v);
+            }
+        for (std::int32_t j = t.cj0; j < t.cj1; ++j) {
+            const float lo = row[j - t.ej0], hi = row_hi[j - t.ej0];
+            if (!(lo >= 0.0f) || static_cast<double>(lo) > keep_below) continue;  // (also the absent pairs)
+            // Most cells below the threshold lie on a valley's slope: a surely smaller
+            // (or excluded) direct neighbour rejects them before the full neighbourhood.
+            if (hi_at(i, j - 1) < lo || hi_at(i, j + 1) < lo || hi_at(i - 1, j) < lo || hi_at(i + 1, j) < lo) continue;
+            if (hi_at(i - 1, j - 1) < lo || hi_at(i + 1, j + 1) < lo || hi_at(i - 1, j + 1) < lo || hi_at(i + 1, j - 1) < lo)
+                continue;
+            bool minimum = true;
+            s.undecided.clear();
+            for (int di = -h; di <= h && minimum; ++di)
+                for (int dj = -h; dj <= h; ++dj) {
+                    if (di == 0 && dj == 0) continue;
+                    if (hi_at(i + di, j + dj) < lo) {  // surely smaller, or excluded (−1)
+                        minimum = false;
+                        break;
+                    }
+                    if (lo_at(i + di, j + dj) <= hi) s.undecided.push_back({di, dj});  // else surely larger, or absent
+                }
+            if (!minimum) continue;
+            const float v = exact_distance(f, i, j, lo, hi, s);
+            if (static_cast<double>(v) > keep_below) continue;
+            for (const auto& [di, dj] : s.undecided) {
+                const float ulo = lo_at(i + di, j + dj), uhi = hi_at(i + di, j + dj);
+                const float u = ulo == uhi ? ulo : exact_distance(f, i + di, j + dj, ulo, uhi, s);
+                if (u < v || (u == v && (di < 0 || (di == 0 && dj < 0)))) {
+                    minimum = false;
+                    break;
+                }
+            }
+            if (!minimum) continue;
+            if (v <= o.threshold) {
+                s.found.push_back({i, j, v});
+                continue;
+            }
+            auto& best = bridges[{f.clip_of[static_cast<size_t>(i)], f.clip_of[static_cast<size_t>(j)]}];
+            best.push_back({i, j, v});
+            std::sort(best.begin(), best.end(),
+                      [](const TransitionCandidate& a, const TransitionCandidate& b) { return a.distance < b.distance; });
+            if (best.size() > static_cast<size_t>(o.bridges_per_clip_pair)) best.pop_back();
+        }
+    }
+    for (const auto& [clips, best] : bridges) s.found.insert(s.found.end(), best.begin(), best.end());
+}
+
+void run_tile(const FrameFeatures& f, const CandidateSearchOptions& o, const DistanceErrorBound& bound, std::int32_t i0,
+              std::int32_t i1, std::int32_t j0, std::int32_t j1, TileScratch& s) {
     const std::int32_t k = f.window, h = o.neighbourhood, N = f.frames;
     const std::int32_t i_end = N - k + 1, j_begin = k - 1;  // valid i < i_end, j ≥ j_begin
     const std::int32_t ci0 = std::max(i0, 0), ci1 = std::min(i1, i_end);
@@ -417,6 +537,11 @@ void run_tile(const FrameFeatures& f, const CandidateSearchOptions& o, std::int3
     row_dots(f.xz.data(), row0, nr, f.xz.data(), col0, nc, width, s.ca.data());
     row_dots(f.xz.data(), row0, nr, f.zx.data(), col0, nc, width, s.cb.data());
     row_dots(f.y.data(), row0, nr, f.y.data(), col0, nc, J, s.cy.data());
+    if (o.product_noise > 0.0) {
+        perturb_products(s.ca.data(), row0, nr, col0, nc, o.product_noise * bound.product_xz, 0);
+        perturb_products(s.cb.data(), row0, nr, col0, nc, o.product_noise * bound.product_xz, 1);
+        perturb_products(s.cy.data(), row0, nr, col0, nc, o.product_noise * bound.product_y, 2);
+    }
 
     const std::int32_t dr = ei1 - ei0, dc = ej1 - ej0;
     s.row_cx.assign(f.cx.begin() + row0, f.cx.begin() + row0 + nr);
@@ -443,6 +568,7 @@ void run_tile(const FrameFeatures& f, const CandidateSearchOptions& o, std::int3
     // Window sums row by row: row 0 and column 0 directly, the rest by sliding along
     // the diagonals (two double adds per sum and pair instead of k).
     s.d.ensure(static_cast<size_t>(dr) * udc);
+    s.hi.ensure(static_cast<size_t>(dr) * udc);
     s.sums[0].resize(kSumCount * udc);
     s.sums[1].resize(kSumCount * udc);
     const double inv_wk = 1.0 / (f.weight * k);
@@ -457,64 +583,26 @@ void run_tile(const FrameFeatures& f, const CandidateSearchOptions& o, std::int3
         }
         const std::int32_t i = ei0 + r;
         const size_t ui = static_cast<size_t>(i);
-        float* __restrict out = s.d.data() + static_cast<size_t>(r) * udc;
+        float* __restrict lo = s.d.data() + static_cast<size_t>(r) * udc;
+        float* __restrict hi = s.hi.data() + static_cast<size_t>(r) * udc;
         if (!f.start_ok[ui]) {
-            std::fill(out, out + dc, kPairInvalid);
+            std::fill(lo, lo + dc, kPairInvalid);
+            std::fill(hi, hi + dc, kPairInvalid);
             continue;
         }
         // Branch-free over the row (it vectorises); invalid and near-diagonal pairs
-        // are patched afterwards from short lists.
+        // are patched afterwards from short lists (their status is exact).
         window_distances(cur, dc, RowWindow{f.window_spread[ui], f.window_cx[ui], f.window_cz[ui]}, f.weight, inv_wk,
-                         s.col_spread.data(), s.col_x.data(), s.col_z.data(), out);
-        for (const std::int32_t c : s.invalid_cols) out[c] = kPairInvalid;
+                         bound.distance, s.col_spread.data(), s.col_x.data(), s.col_z.data(), lo, hi);
+        for (const std::int32_t c : s.invalid_cols) lo[c] = hi[c] = kPairInvalid;
         // Same clip and windows starting at most k frames apart: g ∈ [i − k, i + k].
         const std::int32_t c_lo = std::max(i - k - col0, 0), c_hi = std::min(i + k - col0, dc - 1);
         for (std::int32_t c = c_lo; c <= c_hi; ++c)
-            if (f.clip_of[static_cast<size_t>(col0 + c)] == f.clip_of[ui] && out[c] != kPairInvalid) out[c] = kPairExcluded;
+            if (f.clip_of[static_cast<size_t>(col0 + c)] == f.clip_of[ui] && lo[c] != kPairInvalid)
+                lo[c] = hi[c] = kPairExcluded;
     }
 
-    std::map<std::pair<std::int32_t, std::int32_t>, std::vector<TransitionCandidate>> bridges;
-    const auto at = [&](std::int32_t i, std::int32_t j) -> float {
-        if (i < ei0 || i >= ei1 || j < ej0 || j >= ej1) return kPairInvalid;  // outside the valid range
-        return s.d[static_cast<size_t>(i - ei0) * static_cast<size_t>(dc) + static_cast<size_t>(j - ej0)];
-    };
-    const double keep_below = std::max(o.threshold, o.bridge_threshold);
-    for (std::int32_t i = ci0; i < ci1; ++i) {
-        const float* __restrict row = s.d.data() + static_cast<size_t>(i - ei0) * udc;  // row[j − ej0]
-        std::int64_t evaluated = 0;  // (a separate branch-free loop: it vectorises)
-        for (std::int32_t c = cj0 - ej0; c < cj1 - ej0; ++c) evaluated += row[c] >= 0.0f && row[c] < kPairInvalid;
-        s.evaluations += evaluated;
-        if (o.plot)
-            for (std::int32_t j = cj0; j < cj1; ++j) {
-                const float v = row[j - ej0];
-                if (!(v >= 0.0f && v < kPairInvalid)) continue;
-                const size_t px = static_cast<size_t>(static_cast<std::int64_t>(i) * o.plot_size / N);
-                const size_t py = static_cast<size_t>(static_cast<std::int64_t>(j) * o.plot_size / N);
-                float& pixel = s.plot[px * static_cast<size_t>(o.plot_size) + py];
-                pixel = std::min(pixel, v);
-            }
-        for (std::int32_t j = cj0; j < cj1; ++j) {
-            const float v = row[j - ej0];
-            if (!(v >= 0.0f) || static_cast<double>(v) > keep_below) continue;  // (also the absent pairs)
-            // Most cells below the threshold lie on a valley's slope: a smaller (or
-            // excluded) direct neighbour rejects them before the full neighbourhood.
-            const float n0 = at(i, j - 1), n1 = at(i, j + 1), n2 = at(i - 1, j), n3 = at(i + 1, j);
-            if (n0 < v || n1 < v || n2 < v || n3 < v) continue;
-            const float n4 = at(i - 1, j - 1), n5 = at(i + 1, j + 1), n6 = at(i - 1, j + 1), n7 = at(i + 1, j - 1);
-            if (n4 < v || n5 < v || n6 < v || n7 < v) continue;
-            if (!is_local_minimum(v, i, j, h, keep_below, at)) continue;
-            if (v <= o.threshold) {
-                s.found.push_back({i, j, v});
-                continue;
-            }
-            auto& best = bridges[{f.clip_of[static_cast<size_t>(i)], f.clip_of[static_cast<size_t>(j)]}];
-            best.push_back({i, j, v});
-            std::sort(best.begin(), best.end(),
-                      [](const TransitionCandidate& a, const TransitionCandidate& b) { return a.distance < b.distance; });
-            if (best.size() > static_cast<size_t>(o.bridges_per_clip_pair)) best.pop_back();
-        }
-    }
-    for (const auto& [clips, best] : bridges) s.found.insert(s.found.end(), best.begin(), best.end());
+    decide_tile_minima(f, o, TileSpan{ci0, ci1, cj0, cj1, ei0, ei1, ej0, ej1}, s);
 }
 
 }  // namespace
@@ -525,12 +613,14 @@ CandidateSearchResult find_transition_candidates(const FrameFeatures& f, const C
     const std::int32_t tiles_per_side = (f.frames + T - 1) / T;
     const std::int64_t tile_count = static_cast<std::int64_t>(tiles_per_side) * tiles_per_side;
     const int threads = static_cast<int>(std::min<std::int64_t>(thread_count(o.threads), std::max<std::int64_t>(tile_count, 1)));
+    // A tile's rows are slid at most T + 2h − 1 times from its directly summed first row.
+    const DistanceErrorBound bound = window_distance_error_bound(f, T + 2 * o.neighbourhood);
     std::vector<TileScratch> scratch(static_cast<size_t>(threads));
     {  // the largest tile plus halo, once: no reallocation as tile sizes vary
         const size_t side = static_cast<size_t>(std::min(T + 2 * o.neighbourhood + f.window - 1, std::max(f.frames, 1)));
         for (TileScratch& s : scratch) {
             s.ca.ensure(side * side), s.cb.ensure(side * side), s.cy.ensure(side * side);
-            s.d.ensure(side * side);
+            s.d.ensure(side * side), s.hi.ensure(side * side);
         }
     }
     if (o.plot)
@@ -541,7 +631,7 @@ CandidateSearchResult find_transition_candidates(const FrameFeatures& f, const C
         for (std::int64_t tile = next++; tile < tile_count; tile = next++) {
             const std::int32_t ti = static_cast<std::int32_t>(tile / tiles_per_side);
             const std::int32_t tj = static_cast<std::int32_t>(tile % tiles_per_side);
-            run_tile(f, o, ti * T, (ti + 1) * T, tj * T, (tj + 1) * T, scratch[static_cast<size_t>(t)]);
+            run_tile(f, o, bound, ti * T, (ti + 1) * T, tj * T, (tj + 1) * T, scratch[static_cast<size_t>(t)]);
             ++done;
             if (t == 0 && o.progress) o.progress(static_cast<double>(done.load()) / static_cast<double>(tile_count));
         }
@@ -553,10 +643,17 @@ CandidateSearchResult find_transition_candidates(const FrameFeatures& f, const C
     if (o.progress) o.progress(1.0);
 
     CandidateSearchResult out;
+    out.distance_bound = bound.distance;
+    std::int64_t violations = 0;
     for (TileScratch& s : scratch) {
         out.candidates.insert(out.candidates.end(), s.found.begin(), s.found.end());
         out.pair_evaluations += s.evaluations;
+        out.exact_evaluations += s.exact_evaluations;
+        violations += s.bound_violations;
     }
+    if (violations > 0)  // a bug in window_distance_error_bound, never a property of the data
+        throw std::logic_error("transition search: " + std::to_string(violations) +
+                               " fixed-order distances fell outside the BLAS pass's error bound");
     std::sort(out.candidates.begin(), out.candidates.end(), [](const TransitionCandidate& a, const TransitionCandidate& b) {
         return a.from_frame != b.from_frame ? a.from_frame < b.from_frame : a.to_frame < b.to_frame;
     });

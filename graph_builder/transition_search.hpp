@@ -1,11 +1,16 @@
 #pragma once
 // Finding transition candidates: Kovar's point-cloud distance between every pair
 // of k-frame windows of the database, computed tile by tile so the N×N matrix is
-// never held. Per tile, the cross terms of all frame pairs are three sgemm products
-// (dgemm) of per-frame feature rows; the k-frame window then becomes a sum sliding
+// never held. Per tile, the cross terms of all frame pairs are three dgemm products
+// of per-frame feature rows; the k-frame window then becomes a sum sliding
 // along the tile's diagonals, and the closed-form 2D alignment turns the sums
 // into the minimal distance. Tiles carry a halo of the local-minimum
 // neighbourhood, so each tile decides its own local minima.
+// BLAS only proposes: each tiled distance comes with a rigorous error bound
+// (distance_bound.hpp) against the fixed-order kernel (feature_pair_distance), and
+// every decision and every kept distance is the fixed-order kernel's, so the
+// candidates are the same bits whichever BLAS kernel, thread count or tile size
+// ran (docs/determinism.md, "Graph builds").
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -56,8 +61,9 @@ inline constexpr float kPairInvalid = 3.0e38f;
 inline constexpr double kDistanceNoiseFloor = 1e-9;
 inline constexpr float kPairExcluded = -1.0f;
 
-// The same quantity for one pair, straight from the features in double (the
-// threshold's percentile sample uses it).
+// The same quantity for one pair, straight from the features in double, in one
+// fixed order (no BLAS): the value every decision and every stored distance uses
+// (the threshold's percentile sample, the candidates' distances).
 double feature_pair_distance(const FrameFeatures& f, std::int32_t i, std::int32_t j);
 
 // The straightforward reference: per pair, per window frame, per joint, from the
@@ -85,11 +91,17 @@ struct CandidateSearchOptions {
     // Optional downsampled image of the matrix (min over each pixel's cells).
     int plot_size = 0;
     std::vector<float>* plot = nullptr;
+    // Tests only: moves every dgemm product by up to this fraction of what the error
+    // bound allows a BLAS kernel (pseudo-random, fixed per pair), as another kernel's
+    // rounding would. The candidates must not change.
+    double product_noise = 0.0;
 };
 
 struct CandidateSearchResult {
     std::vector<TransitionCandidate> candidates;  // sorted by (from, to)
     std::int64_t pair_evaluations = 0;
+    std::int64_t exact_evaluations = 0;  // pairs re-evaluated by the fixed-order kernel
+    double distance_bound = 0.0;         // the tiled pass's error bound (normalised distance)
 };
 
 CandidateSearchResult find_transition_candidates(const FrameFeatures& features, const CandidateSearchOptions& options);

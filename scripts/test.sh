@@ -13,6 +13,11 @@ for preset in release asan; do
   cmake --build --preset "$preset" -j "$jobs"
   echo "== $preset: test"
   ctest --preset "$preset" -j "$jobs"
+  if [ "$preset" = release ]; then
+    # Graph bytes under every OpenBLAS kernel and thread count (builds nothing).
+    echo "== release: graph builds independent of BLAS"
+    bash scripts/check-blas.sh
+  fi
 done
 # ThreadSanitizer: only the pipeline's stress target (a full tsan build would not
 # fit CI's budget on two cores; the handoffs are what it must check).

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <set>
 
@@ -133,6 +134,63 @@ TEST_CASE("the tiled dgemm search finds the same candidates as the reference", "
         CHECK(tiled.candidates[c].to_frame == reference.candidates[c].to_frame);
         CHECK(tiled.candidates[c].distance == Approx(reference.candidates[c].distance).epsilon(1e-3).margin(1e-6));
     }
+}
+
+// BLAS only proposes (docs/determinism.md, "Graph builds"): another kernel's
+// rounding, modelled by moving every dgemm product by up to what the error bound
+// allows, another tile size or thread count must give the same candidates, bit for
+// bit, each with the fixed-order kernel's distance. The exactly periodic database
+// (no noise) is the hard case: its valleys are flat to the rounding.
+TEST_CASE("transition candidates do not depend on BLAS rounding, tile size or thread count", "[graph][distance][blas]") {
+    for (const double noise : {0.0, 0.05}) {
+        INFO("capture noise " << noise);
+        const ClipDatabase db = synthetic_database(noise);
+        const FrameFeatures f = compute_frame_features(db, database_positions(db), 8, 1.0);
+        CandidateSearchOptions o;
+        o.neighbourhood = 3;
+        o.threshold = distance_percentiles(f, {10.0})[0];
+        o.tile = 37;
+        o.threads = 2;
+        const CandidateSearchResult base = find_transition_candidates(f, o);
+        REQUIRE(base.candidates.size() > 5);
+        CHECK(base.distance_bound > 0.0);
+        CHECK(base.distance_bound < 1e-6 * o.threshold);  // tight enough to settle nearly every comparison
+        CHECK(base.exact_evaluations >= static_cast<std::int64_t>(base.candidates.size()));
+        CHECK(base.exact_evaluations < base.pair_evaluations / 10);
+        for (const TransitionCandidate& c : base.candidates)
+            CHECK(c.distance == static_cast<float>(feature_pair_distance(f, c.from_frame, c.to_frame)));
+        const auto variant = [&](double product_noise, int tile, int threads) {
+            CandidateSearchOptions v = o;
+            v.product_noise = product_noise;
+            v.tile = tile;
+            v.threads = threads;
+            return find_transition_candidates(f, v);
+        };
+        for (const CandidateSearchResult& other : {variant(1.0, 37, 2), variant(-1.0, 37, 2), variant(0.5, 64, 1),
+                                                   variant(0.0, 512, 1), variant(1.0, 16, 3)}) {
+            CHECK(other.pair_evaluations == base.pair_evaluations);
+            REQUIRE(other.candidates.size() == base.candidates.size());
+            for (size_t c = 0; c < base.candidates.size(); ++c) {
+                CHECK(other.candidates[c].from_frame == base.candidates[c].from_frame);
+                CHECK(other.candidates[c].to_frame == base.candidates[c].to_frame);
+                CHECK(std::memcmp(&other.candidates[c].distance, &base.candidates[c].distance, sizeof(float)) == 0);
+            }
+        }
+    }
+}
+
+TEST_CASE("a BLAS result outside the error bound fails the search instead of deciding", "[graph][distance][blas]") {
+    // Products moved by a million times the allowance: the fixed-order values of the
+    // cells it proposes fall outside their intervals, and the search says so.
+    const ClipDatabase db = synthetic_database(0.05);
+    const FrameFeatures f = compute_frame_features(db, database_positions(db), 8, 1.0);
+    CandidateSearchOptions o;
+    o.neighbourhood = 3;
+    o.threshold = distance_percentiles(f, {10.0})[0];
+    o.tile = 37;
+    o.threads = 2;
+    o.product_noise = 1e6;
+    CHECK_THROWS_WITH(find_transition_candidates(f, o), Catch::Contains("outside the BLAS pass's error bound"));
 }
 
 TEST_CASE("two builds of the same clips serialize to identical bytes", "[graph][determinism]") {
