@@ -13,7 +13,11 @@
 # for one input) or an allocation over -malloc_limit_mb; the reproducer is
 # left in build/fuzz/findings/<target>/ and the log in build/fuzz/run/<target>.log.
 # Prints each target's executions and final coverage (cov: edges, ft: features).
-# Targets run FUZZ_JOBS at a time (default: the number of cores).
+# Targets run FUZZ_JOBS at a time (default: the number of cores). FUZZ_TIMEOUT
+# overrides every target's per-input limit (libFuzzer's -timeout is wall-clock
+# time, so a heavily loaded machine can turn a 5 ms input into a false timeout:
+# re-run the reproducer alone, `build/fuzz/tests/fuzz/fuzz_<target> FILE`, before
+# calling it a hang).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -24,7 +28,7 @@ while (($#)); do
   case "$1" in
     --grow) grow=1 ;;
     --only) only="$2"; shift ;;
-    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
     *) seconds="$1" ;;
   esac
   shift
@@ -57,7 +61,7 @@ built=$(date +%s)
 bin=build/fuzz/tests/fuzz
 run=build/fuzz/run
 findings=build/fuzz/findings
-rm -rf "$run"
+rm -rf "$run" "$findings"
 mkdir -p "$run" "$findings"
 
 run_one() {
@@ -66,7 +70,7 @@ run_one() {
   mkdir -p "$work" "$findings/$name"
   local seeds=("tests/fuzz/corpus/$name")
   [[ -d "tests/data/fuzz_regressions/$name" ]] && seeds+=("tests/data/fuzz_regressions/$name")
-  local args=(-max_total_time="$seconds" -max_len="$max_len" -timeout="$timeout" -rss_limit_mb=2048
+  local args=(-max_total_time="$seconds" -max_len="$max_len" -timeout="${FUZZ_TIMEOUT:-$timeout}" -rss_limit_mb=2048
               -malloc_limit_mb=512 -print_final_stats=1 -artifact_prefix="$findings/$name/")
   [[ "$dict" != - ]] && args+=(-dict="tests/fuzz/dict/$dict")
   local rc=0

@@ -2,7 +2,8 @@
 # Builds and runs every test: the optimised build first, then the asan build
 # (AddressSanitizer + UBSan). The golden replay traces are checked in both, so an
 # optimisation-dependent result fails here. Then ThreadSanitizer, on the lock-free
-# stress tests only (tests/stress). `.ci/run` calls exactly this.
+# stress tests only (tests/stress). Last, the fuzz targets for 30 s each
+# (scripts/fuzz.sh). `.ci/run` calls exactly this.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -21,3 +22,8 @@ cmake --preset tsan >/dev/null
 cmake --build --preset tsan -j "$jobs" --target marionette_stress_tests
 echo "== tsan: test"
 ctest --preset tsan -R '^stress:' -j 1
+# Fuzz regression gate (issue 18): every libFuzzer target of tests/fuzz for 30 s
+# on its seed corpus and kept reproducers; any crash, UB, leak, timeout or huge
+# allocation fails. Builds only the fuzz targets (the `fuzz` preset, clang 14).
+echo "== fuzz: every target for 30 s"
+bash scripts/fuzz.sh 30
