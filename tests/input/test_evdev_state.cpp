@@ -62,7 +62,7 @@ TEST_CASE("evdev state: axes, flat zone, y flipped, hat as d-pad, buttons by pos
     CHECK((out.buttons & button_bit(Button::south)) == 0);
 }
 
-TEST_CASE("evdev state: digital triggers only without analog ones; triggers may come from ABS_HAT2Y/X") {
+TEST_CASE("evdev state: digital triggers only without analog ones, and triggers from ABS_HAT2Y or ABS_HAT2X") {
     EvdevState digital;
     digital.set_axis_info(EvdevState::kLx, 0, 255, 0, 0, 128);
     digital.on_event(EV_KEY, BTN_TL2, 1);
