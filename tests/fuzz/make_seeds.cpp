@@ -3,6 +3,7 @@
 //   cmake --build --preset fuzz --target marionette_fuzz_seeds
 //   build/fuzz/tests/fuzz/marionette_fuzz_seeds tests/fuzz/corpus
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@ using namespace marionette;
 
 namespace {
 void write(const std::string& path, const std::vector<std::uint8_t>& bytes) {
+    std::filesystem::create_directories(std::filesystem::path(path).parent_path());
     std::ofstream out(path, std::ios::binary);
     out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
     if (!out) {
