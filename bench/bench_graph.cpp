@@ -237,7 +237,10 @@ void BM_ControllerCircleCmu16(benchmark::State& state) {
         in.stick_x = static_cast<float>(det::sin(a));
         in.stick_y = static_cast<float>(-det::cos(a));
         const auto t0 = std::chrono::steady_clock::now();
-        controller.step(s, in, r, t);
+        if (!controller.step(s, in, {r, t})) {
+            state.SkipWithError("the graph controller refused its pose spans");
+            break;
+        }
         micros.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count());
         benchmark::DoNotOptimize(r.data());
     }
@@ -283,7 +286,10 @@ void controller_circle_actions(benchmark::State& state, const MotionGraph& g) {
         ++tick;
         const bool querying = s.mode == GraphMotionMode::find_action || (in.buttons != 0 && s.mode == GraphMotionMode::locomotion);
         const auto t0 = std::chrono::steady_clock::now();
-        controller.step(s, in, r, t);
+        if (!controller.step(s, in, {r, t})) {
+            state.SkipWithError("the graph controller refused its pose spans");
+            break;
+        }
         const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
         micros.push_back(us);
         if (querying) query_micros.push_back(us);
@@ -310,7 +316,7 @@ void BM_ControllerCircleActionsCmu16(benchmark::State& state) {
 }
 
 void BM_ControllerCircleActionsDefault(benchmark::State& state) {
-    static const MotionGraph g = build_default_motion_graph(SimConfig{});
+    static const MotionGraph g = build_default_motion_graph(SimConfig{}, GraphBuildConfig{});
     controller_circle_actions(state, g);
 }
 

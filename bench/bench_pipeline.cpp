@@ -104,7 +104,7 @@ BENCHMARK(BM_TripleBufferHandoffLatency)->UseRealTime()->MinTime(0.5);
 // headless 60 Hz frames, for `seconds` of the demo program.
 void BM_EndToEndInputToTick(benchmark::State& state) {
     const double seconds = static_cast<double>(state.range(0));
-    const SimConfig config = default_config();
+    const SimConfig config = default_config().sim;
     const StickProgram program = load_program("builtin:demo");
     PipelineResult r;
     for (auto _ : state) {

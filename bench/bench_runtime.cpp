@@ -19,10 +19,12 @@ void BM_LocalToModel(benchmark::State& state) {
     const size_t n = static_cast<size_t>(skeleton.joint_count());
     std::vector<quat> mr(n);
     std::vector<vec3> mp(n);
-    const LocalToModelJob job{skeleton.parents, std::span<const quat>(walk.frame_rotations(10), n),
-                              std::span<const vec3>(walk.frame_translations(10), n), mr, mp};
+    const LocalToModelJob job{skeleton.parents,
+                              {std::span<const quat>(walk.frame_rotations(10), n),
+                               std::span<const vec3>(walk.frame_translations(10), n)},
+                              {mr, mp}};
     for (auto _ : state) {
-        job.run();
+        if (!job.run()) state.SkipWithError("LocalToModelJob refused its inputs");
         benchmark::DoNotOptimize(mp.data());
         benchmark::ClobberMemory();
     }

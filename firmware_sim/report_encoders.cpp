@@ -37,26 +37,43 @@ void pack12(std::uint8_t* out, std::int32_t lo, std::int32_t hi) {
 }
 std::uint8_t sony_buttons0(const PadState& s) {
     std::uint8_t b = dpad_to_hat(s.buttons);
-    if (has(s.buttons, Button::west)) b |= ds4::kSquare;
-    if (has(s.buttons, Button::south)) b |= ds4::kCross;
-    if (has(s.buttons, Button::east)) b |= ds4::kCircle;
-    if (has(s.buttons, Button::north)) b |= ds4::kTriangle;
+    if (has(s.buttons, Button::west)) b |= kSonySquare;
+    if (has(s.buttons, Button::south)) b |= kSonyCross;
+    if (has(s.buttons, Button::east)) b |= kSonyCircle;
+    if (has(s.buttons, Button::north)) b |= kSonyTriangle;
     return b;
 }
 std::uint8_t sony_buttons1(const PadState& s) {
     std::uint8_t b = 0;
-    if (has(s.buttons, Button::left_shoulder)) b |= ds4::kL1;
-    if (has(s.buttons, Button::right_shoulder)) b |= ds4::kR1;
-    if (s.lt > 0.0) b |= ds4::kL2;  // the digital bit follows the analogue trigger
-    if (s.rt > 0.0) b |= ds4::kR2;
-    if (has(s.buttons, Button::back)) b |= ds4::kShare;
-    if (has(s.buttons, Button::start)) b |= ds4::kOptions;
-    if (has(s.buttons, Button::left_stick)) b |= ds4::kL3;
-    if (has(s.buttons, Button::right_stick)) b |= ds4::kR3;
+    if (has(s.buttons, Button::left_shoulder)) b |= kSonyL1;
+    if (has(s.buttons, Button::right_shoulder)) b |= kSonyR1;
+    if (s.lt > 0.0) b |= kSonyL2;  // the digital bit follows the analogue trigger
+    if (s.rt > 0.0) b |= kSonyR2;
+    if (has(s.buttons, Button::back)) b |= kSonyShare;
+    if (has(s.buttons, Button::start)) b |= kSonyOptions;
+    if (has(s.buttons, Button::left_stick)) b |= kSonyL3;
+    if (has(s.buttons, Button::right_stick)) b |= kSonyR3;
     return b;
 }
-void seal_bluetooth(Report& r, std::size_t crc_offset, std::uint8_t seed) {
-    put_u32(&r.bytes[crc_offset], sony_bt_crc32(seed, std::span<const std::uint8_t>(r.bytes.data(), crc_offset)));
+// The report id, size, sticks, triggers and face/shoulder buttons at `layout`'s
+// offsets; returns where the USB offsets start (after the Bluetooth shift).
+std::uint8_t* encode_sony_fields(const PadState& s, const SonyReportLayout& layout, bool bluetooth, Report& r) {
+    r.size = bluetooth ? layout.bt_report_size : layout.usb_report_size;
+    r.bytes[0] = bluetooth ? layout.bt_report_id : layout.usb_report_id;
+    std::uint8_t* p = r.bytes.data() + (bluetooth ? layout.bt_shift : 0);
+    p[layout.left_x] = encode_centred8(s.lx);
+    p[layout.left_y] = encode_centred8(-s.ly);
+    p[layout.right_x] = encode_centred8(s.rx);
+    p[layout.right_y] = encode_centred8(-s.ry);
+    p[layout.left_trigger] = static_cast<std::uint8_t>(encode_trigger(s.lt, 0, 255));
+    p[layout.right_trigger] = static_cast<std::uint8_t>(encode_trigger(s.rt, 0, 255));
+    p[layout.buttons0] = sony_buttons0(s);
+    p[layout.buttons1] = sony_buttons1(s);
+    return p;
+}
+void seal_bluetooth(Report& r, const SonyReportLayout& layout) {
+    put_u32(&r.bytes[layout.bt_crc_offset],
+            sony_bt_crc32(layout.bt_crc_seed, std::span<const std::uint8_t>(r.bytes.data(), layout.bt_crc_offset)));
 }
 }  // namespace
 
@@ -75,44 +92,22 @@ std::int16_t encode_s16(double v) { return static_cast<std::int16_t>(encode_cent
 
 Report encode_ds4(const PadState& s, const ReportClock& clock, bool bluetooth) {
     Report r;
-    const std::size_t shift = bluetooth ? ds4::kBtShift : 0;
-    r.size = bluetooth ? ds4::kBtReportSize : ds4::kUsbReportSize;
-    r.bytes[0] = bluetooth ? ds4::kBtReportId : ds4::kUsbReportId;
+    std::uint8_t* p = encode_sony_fields(s, ds4::kLayout, bluetooth, r);
     if (bluetooth) r.bytes[1] = 0xC0;  // HID + CRC flags, as the pad sends
-    std::uint8_t* p = r.bytes.data() + shift;
-    p[ds4::kLeftX] = encode_centred8(s.lx);
-    p[ds4::kLeftY] = encode_centred8(-s.ly);
-    p[ds4::kRightX] = encode_centred8(s.rx);
-    p[ds4::kRightY] = encode_centred8(-s.ry);
-    p[ds4::kButtons0] = sony_buttons0(s);
-    p[ds4::kButtons1] = sony_buttons1(s);
-    p[ds4::kButtons2] = static_cast<std::uint8_t>(((clock.counter & 0x3F) << ds4::kCounterShift) |
-                                                  (has(s.buttons, Button::guide) ? ds4::kPs : 0));
-    p[ds4::kLeftTrigger] = static_cast<std::uint8_t>(encode_trigger(s.lt, 0, 255));
-    p[ds4::kRightTrigger] = static_cast<std::uint8_t>(encode_trigger(s.rt, 0, 255));
+    p[ds4::kLayout.buttons2] = static_cast<std::uint8_t>(((clock.counter & 0x3F) << ds4::kLayout.counter_shift) |
+                                                         (has(s.buttons, Button::guide) ? kSonyPs : 0));
     put_u16(p + ds4::kTimestamp, static_cast<std::uint16_t>(clock.device_time_us * 3 / 16));  // 5.33 µs units
-    if (bluetooth) seal_bluetooth(r, ds4::kBtCrcOffset, ds4::kBtCrcSeed);
+    if (bluetooth) seal_bluetooth(r, ds4::kLayout);
     return r;
 }
 
 Report encode_dualsense(const PadState& s, const ReportClock& clock, bool bluetooth) {
     Report r;
-    const std::size_t shift = bluetooth ? dualsense::kBtShift : 0;
-    r.size = bluetooth ? dualsense::kBtReportSize : dualsense::kUsbReportSize;
-    r.bytes[0] = bluetooth ? dualsense::kBtReportId : dualsense::kUsbReportId;
-    std::uint8_t* p = r.bytes.data() + shift;
-    p[dualsense::kLeftX] = encode_centred8(s.lx);
-    p[dualsense::kLeftY] = encode_centred8(-s.ly);
-    p[dualsense::kRightX] = encode_centred8(s.rx);
-    p[dualsense::kRightY] = encode_centred8(-s.ry);
-    p[dualsense::kLeftTrigger] = static_cast<std::uint8_t>(encode_trigger(s.lt, 0, 255));
-    p[dualsense::kRightTrigger] = static_cast<std::uint8_t>(encode_trigger(s.rt, 0, 255));
-    p[dualsense::kSequence] = static_cast<std::uint8_t>(clock.counter);
-    p[dualsense::kButtons0] = sony_buttons0(s);
-    p[dualsense::kButtons1] = sony_buttons1(s);
-    p[dualsense::kButtons2] = has(s.buttons, Button::guide) ? dualsense::kPs : 0;
+    std::uint8_t* p = encode_sony_fields(s, dualsense::kLayout, bluetooth, r);
+    p[dualsense::kLayout.counter] = static_cast<std::uint8_t>(clock.counter);
+    p[dualsense::kLayout.buttons2] = has(s.buttons, Button::guide) ? kSonyPs : 0;
     put_u32(p + dualsense::kSensorTimestamp, static_cast<std::uint32_t>(clock.device_time_us * 3));  // 0.33 µs units
-    if (bluetooth) seal_bluetooth(r, dualsense::kBtCrcOffset, dualsense::kBtCrcSeed);
+    if (bluetooth) seal_bluetooth(r, dualsense::kLayout);
     return r;
 }
 

@@ -9,6 +9,7 @@
 
 #include "runtime/formats/asf_amc.hpp"
 #include "runtime/formats/bvh.hpp"
+#include "runtime/formats/file_names.hpp"
 #include "runtime/errors/import_error.hpp"
 
 namespace marionette::offline {
@@ -16,15 +17,6 @@ namespace marionette::offline {
 namespace {
 
 int line_of(const toml::node& n) { return static_cast<int>(n.source().begin.line); }
-
-std::string lower_extension(const std::string& path) {
-    const size_t dot = path.find_last_of('.');
-    const size_t slash = path.find_last_of('/');
-    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return {};
-    std::string ext = path.substr(dot + 1);
-    for (char& c : ext) c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
-    return ext;
-}
 
 std::string lower(std::string s) {
     for (char& c : s) c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
@@ -109,7 +101,7 @@ std::int64_t ClipDatabase::frame_count() const {
     return n;
 }
 
-std::string skeleton_mismatch(const Skeleton& a, const Skeleton& b) {
+Outcome same_skeleton(const Skeleton& a, const Skeleton& b) {
     const int n = std::min(a.joint_count(), b.joint_count());
     const auto parent_name = [](const Skeleton& s, int j) {
         const int p = s.parents[static_cast<size_t>(j)];
@@ -118,12 +110,13 @@ std::string skeleton_mismatch(const Skeleton& a, const Skeleton& b) {
     for (int j = 0; j < n; ++j) {
         const size_t u = static_cast<size_t>(j);
         if (a.joint_names[u] != b.joint_names[u] || a.parents[u] != b.parents[u])
-            return "joint " + std::to_string(j) + " is '" + b.joint_names[u] + "' (" + parent_name(b, j) +
-                   ") where the first clip has '" + a.joint_names[u] + "' (" + parent_name(a, j) + ")";
+            return Outcome::failure("joint " + std::to_string(j) + " is '" + b.joint_names[u] + "' (" +
+                                    parent_name(b, j) + ") where the first clip has '" + a.joint_names[u] + "' (" +
+                                    parent_name(a, j) + ")");
     }
     if (a.joint_count() != b.joint_count())
-        return std::to_string(b.joint_count()) + " joints where the first clip has " + std::to_string(a.joint_count());
-    return {};
+        return Outcome::failure(std::to_string(b.joint_count()) + " joints where the first clip has " + std::to_string(a.joint_count()));
+    return Outcome::success();
 }
 
 ClipDatabase make_clip_database(std::vector<Clip> clips, const std::vector<std::string>& names,
@@ -136,8 +129,8 @@ ClipDatabase make_clip_database(std::vector<Clip> clips, const std::vector<std::
     db.analysis_rate_hz = rate;
     for (size_t c = 0; c < clips.size(); ++c) {
         const std::string& where = c < names.size() ? names[c] : clips[c].name;
-        if (std::string e = skeleton_mismatch(db.skeleton, clips[c].skeleton); !e.empty())
-            throw ImportError(where, 0, "skeleton differs from " + (names.empty() ? clips[0].name : names[0]) + ": " + e +
+        if (const Outcome same = same_skeleton(db.skeleton, clips[c].skeleton); !same.ok())
+            throw ImportError(where, 0, "skeleton differs from " + (names.empty() ? clips[0].name : names[0]) + ": " + same.problem() +
                                             " (every clip of a motion graph must share one skeleton)");
         for (size_t d = 0; d < c; ++d)
             if (clips[d].name == clips[c].name)

@@ -51,8 +51,8 @@ ClipDatabase load_clip_database(const std::vector<std::string>& clip_files, cons
 ClipDatabase make_clip_database(std::vector<Clip> clips, const std::vector<std::string>& names_for_errors,
                                 const LabelRules& rules, double analysis_rate_hz);
 
-// Empty when `b` has the same joint names and hierarchy as `a`, else the first difference.
-std::string skeleton_mismatch(const Skeleton& a, const Skeleton& b);
+// Ok when `b` has the same joint names and hierarchy as `a`, else the first difference.
+Outcome same_skeleton(const Skeleton& a, const Skeleton& b);
 
 // Shell-glob match (*, ?, [...]) of a whole name.
 bool name_matches(const std::string& pattern, const std::string& name);

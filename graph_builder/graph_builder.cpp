@@ -118,16 +118,13 @@ void assemble_graph(MotionGraph& g, const FrameFeatures& features, const std::ve
     index_edges(g);
 }
 
-}  // namespace
+constexpr int kMaxBridgeRounds = 64;  // rounds of adding bridges before the build keeps what it has
 
-GraphBuildOutput build_motion_graph(const ClipDatabase& db, const GraphBuildParams& params, const GraphBuildHooks& hooks) {
-    GraphBuildOutput out;
-    const int k = params.window_frames;
-    const int J = db.skeleton.joint_count();
-    const double leg = skeleton_leg_length(db.skeleton, db.left_foot >= 0 ? db.left_foot : db.right_foot);
-    const std::vector<vec3> positions = database_positions(db);
-    const FrameFeatures features = compute_frame_features(db, positions, k, leg);
-    out.frames = features.frames;
+// The thresholds (the distance percentiles, or the absolute threshold), then
+// the tiled search for local minima below the bridge threshold. Returns how
+// many window pairs the search compared.
+std::int64_t search_transitions(const FrameFeatures& features, const GraphBuildParams& params, const GraphBuildHooks& hooks,
+                                GraphBuildOutput& out) {
     const std::vector<double> percentiles =
         distance_percentiles(features, {params.threshold_percentile, params.bridge_percentile});
     out.threshold = params.threshold_absolute > 0.0 ? params.threshold_absolute : percentiles[0];
@@ -146,14 +143,20 @@ GraphBuildOutput build_motion_graph(const ClipDatabase& db, const GraphBuildPara
         search.plot = &out.plot;
     }
     CandidateSearchResult found = find_transition_candidates(features, search);
-    out.candidates = found.candidates;
+    out.candidates = std::move(found.candidates);
+    return found.pair_evaluations;
+}
 
-    MotionGraph& g = out.graph;
+// The graph's skeleton and metadata from the database, and every clip's frames
+// one after another with their foot contacts (no nodes or edges yet).
+void copy_clips(const ClipDatabase& db, const std::vector<vec3>& positions, double leg, const GraphBuildParams& params,
+                MotionGraph& g) {
+    const int J = db.skeleton.joint_count();
     g.skeleton = db.skeleton;
     g.animated_translation = db.animated_translation;
     g.length_unit = db.length_unit;
     g.frame_rate = db.analysis_rate_hz;
-    g.window_frames = k;
+    g.window_frames = params.window_frames;
     g.leg_length = static_cast<float>(leg);
     g.left_foot = db.left_foot;
     g.right_foot = db.right_foot;
@@ -171,101 +174,146 @@ GraphBuildOutput build_motion_graph(const ClipDatabase& db, const GraphBuildPara
         g.contacts.insert(g.contacts.end(), contacts.begin(), contacts.end());
         first += clip.frame_count;
     }
+}
 
-    // Regular transitions below the threshold; then, while a clip is cut off
-    // from the largest component, the cheapest bridge (a local minimum below the
-    // looser bridge threshold) into and out of it, until it joins or none is left.
-    // Usable candidates (something to continue with after the arrival), each placed
-    // once by the closed-form alignment of its windows, in parallel.
+// Usable candidates (something to continue with after the arrival), each placed
+// once by the closed-form alignment of its windows, in parallel.
+std::vector<PlacedTransition> place_candidates(const ClipDatabase& db, const std::vector<vec3>& positions,
+                                               const FrameFeatures& features,
+                                               const std::vector<TransitionCandidate>& candidates, double leg,
+                                               const GraphBuildParams& params) {
     std::vector<PlacedTransition> placed;
-    for (const TransitionCandidate& t : out.candidates) {
+    for (const TransitionCandidate& t : candidates) {
         const std::int32_t arrival = t.to_frame + 1;
         if (arrival >= features.frames ||
             features.clip_of[static_cast<size_t>(arrival)] != features.clip_of[static_cast<size_t>(t.to_frame)])
             continue;
         placed.push_back({t, {}});
     }
-    {
-        const unsigned threads = std::max(1u, params.threads > 0 ? static_cast<unsigned>(params.threads)
-                                                                 : std::thread::hardware_concurrency());
-        std::vector<std::thread> workers;
-        for (unsigned w = 0; w < threads; ++w)
-            workers.emplace_back([&, w] {
-                for (size_t c = w; c < placed.size(); c += threads)
-                    reference_pair_distance(db, positions, k, leg, placed[c].candidate.from_frame,
-                                            placed[c].candidate.to_frame, &placed[c].align);
-            });
-        for (std::thread& t : workers) t.join();
-    }
-    std::vector<PlacedTransition> chosen, bridges;
-    for (const PlacedTransition& t : placed) (t.candidate.distance <= out.threshold ? chosen : bridges).push_back(t);
-    out.regular_candidates = static_cast<std::int64_t>(chosen.size());
+    const unsigned threads =
+        std::max(1u, params.threads > 0 ? static_cast<unsigned>(params.threads) : std::thread::hardware_concurrency());
+    std::vector<std::thread> workers;
+    for (unsigned w = 0; w < threads; ++w)
+        workers.emplace_back([&, w] {
+            for (size_t c = w; c < placed.size(); c += threads)
+                reference_pair_distance(db, positions, params.window_frames, leg, placed[c].candidate.from_frame,
+                                        placed[c].candidate.to_frame, &placed[c].align);
+        });
+    for (std::thread& t : workers) t.join();
+    return placed;
+}
+
+// The candidates above the threshold, cheapest first (ties by frames, so every
+// machine picks the same), indexed by the clip each arrives in and each leaves.
+struct BridgePool {
+    std::vector<PlacedTransition> bridges;
+    std::vector<bool> used;
+    std::vector<std::vector<size_t>> arriving, leaving;
+};
+
+BridgePool make_bridge_pool(std::vector<PlacedTransition> bridges, const FrameFeatures& features, size_t clip_count) {
     std::sort(bridges.begin(), bridges.end(), [](const PlacedTransition& x, const PlacedTransition& y) {
         const TransitionCandidate &a = x.candidate, &b = y.candidate;
         return a.distance != b.distance ? a.distance < b.distance
                                         : (a.from_frame != b.from_frame ? a.from_frame < b.from_frame : a.to_frame < b.to_frame);
     });
-    std::vector<bool> used(bridges.size(), false);
-    // Bridges by the clip they arrive in and the clip they leave.
-    std::vector<std::vector<size_t>> arriving(g.clips.size()), leaving(g.clips.size());
-    for (size_t b = 0; b < bridges.size(); ++b) {
-        arriving[static_cast<size_t>(features.clip_of[static_cast<size_t>(bridges[b].candidate.to_frame)])].push_back(b);
-        leaving[static_cast<size_t>(features.clip_of[static_cast<size_t>(bridges[b].candidate.from_frame)])].push_back(b);
+    BridgePool pool;
+    pool.bridges = std::move(bridges);
+    pool.used.assign(pool.bridges.size(), false);
+    pool.arriving.resize(clip_count);
+    pool.leaving.resize(clip_count);
+    for (size_t b = 0; b < pool.bridges.size(); ++b) {
+        const TransitionCandidate& t = pool.bridges[b].candidate;
+        pool.arriving[static_cast<size_t>(features.clip_of[static_cast<size_t>(t.to_frame)])].push_back(b);
+        pool.leaving[static_cast<size_t>(features.clip_of[static_cast<size_t>(t.from_frame)])].push_back(b);
     }
+    return pool;
+}
+
+// Which clips the pruned graph kept.
+std::vector<bool> kept_clips(const MotionGraph& g) {
+    std::vector<bool> kept(g.clips.size(), false);
+    for (const std::string& name : kept_clip_names(g)) kept[static_cast<size_t>(g.clip_index(name))] = true;
+    return kept;
+}
+
+// Frames on the pruned graph's clip edges: a bridge must leave from and arrive on one.
+std::vector<bool> frames_on_clip_edges(const MotionGraph& g, const FrameFeatures& features) {
+    std::vector<bool> on_kept(static_cast<size_t>(features.frames), false);
+    for (const GraphEdge& e : g.edges)
+        if (e.kind == GraphEdgeKind::clip) {
+            const GraphNode& n = g.nodes[static_cast<size_t>(e.from)];
+            const std::int32_t f0 = g.clips[static_cast<size_t>(n.clip)].first_frame + n.frame;
+            for (std::int32_t f = f0; f <= f0 + e.frames; ++f) on_kept[static_cast<size_t>(f)] = true;
+        }
+    return on_kept;
+}
+
+// The cheapest unused pair for cut-off clip c: a bridge arriving in it (from the
+// kept graph) no later than another leaves it (back onto the kept graph).
+// False when there is none.
+bool cheapest_bridge_pair(const BridgePool& pool, size_t c, const std::vector<bool>& on_kept, size_t& best_in,
+                          size_t& best_out) {
+    best_in = pool.bridges.size();
+    best_out = pool.bridges.size();
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t bi : pool.arriving[c]) {
+        const TransitionCandidate& in = pool.bridges[bi].candidate;
+        if (pool.used[bi] || !on_kept[static_cast<size_t>(in.from_frame)]) continue;
+        for (size_t bo : pool.leaving[c]) {
+            const TransitionCandidate& leave = pool.bridges[bo].candidate;
+            // Usable candidates arrive inside their clip (place_candidates), so to_frame + 1 exists.
+            if (pool.used[bo] || !on_kept[static_cast<size_t>(leave.to_frame + 1)] || leave.from_frame < in.to_frame + 1)
+                continue;
+            const double cost = static_cast<double>(in.distance) + leave.distance;
+            if (cost < best) best = cost, best_in = bi, best_out = bo;
+        }
+    }
+    return best_in != pool.bridges.size();
+}
+
+// One bridge pair into and out of each clip the pruned graph lost; false when
+// no such pair was left.
+bool add_bridges(const MotionGraph& g, const FrameFeatures& features, BridgePool& pool,
+                 std::vector<PlacedTransition>& chosen, std::int64_t& bridges_added) {
+    const std::vector<bool> kept = kept_clips(g);
+    const std::vector<bool> on_kept = frames_on_clip_edges(g, features);
+    bool added = false;
+    for (size_t c = 0; c < g.clips.size(); ++c) {
+        size_t best_in = 0, best_out = 0;
+        if (kept[c] || !cheapest_bridge_pair(pool, c, on_kept, best_in, best_out)) continue;
+        for (size_t pick : {best_in, best_out}) {
+            pool.used[pick] = true;
+            chosen.push_back(pool.bridges[pick]);
+            ++bridges_added;
+        }
+        added = true;
+    }
+    return added;
+}
+
+// The graph from the regular transitions, pruned to its largest component; then,
+// while a clip is cut off from it, the cheapest bridge pair (local minima below
+// the looser bridge threshold) into and out of that clip, until it joins or none
+// is left.
+void assemble_with_bridges(MotionGraph& g, const FrameFeatures& features, std::vector<PlacedTransition> chosen,
+                           BridgePool pool, int k, GraphBuildOutput& out) {
     const MotionGraph base = g;
     for (int round = 0;; ++round) {
         g = base;
         assemble_graph(g, features, chosen, k);
         out.prune = prune_to_largest_component(g);
-        if (round >= 64) break;
-        std::vector<bool> kept(g.clips.size(), false);
-        for (const std::string& name : kept_clip_names(g)) kept[static_cast<size_t>(g.clip_index(name))] = true;
-        // Frames on kept clip edges: a bridge must leave from and arrive on one.
-        std::vector<bool> on_kept(static_cast<size_t>(features.frames), false);
-        for (const GraphEdge& e : g.edges)
-            if (e.kind == GraphEdgeKind::clip) {
-                const GraphNode& n = g.nodes[static_cast<size_t>(e.from)];
-                const std::int32_t f0 = g.clips[static_cast<size_t>(n.clip)].first_frame + n.frame;
-                for (std::int32_t f = f0; f <= f0 + e.frames; ++f) on_kept[static_cast<size_t>(f)] = true;
-            }
-        bool added = false;
-        for (size_t c = 0; c < g.clips.size(); ++c) {
-            if (kept[c]) continue;
-            // The cheapest pair: a bridge arriving in clip c no later than another leaves it.
-            size_t best_in = bridges.size(), best_out = bridges.size();
-            double best = std::numeric_limits<double>::infinity();
-            for (size_t bi : arriving[c]) {
-                const TransitionCandidate& in = bridges[bi].candidate;
-                if (used[bi] || !on_kept[static_cast<size_t>(in.from_frame)]) continue;
-                for (size_t bo : leaving[c]) {
-                    const TransitionCandidate& leave = bridges[bo].candidate;
-                    // Usable candidates arrive inside their clip (checked above), so to_frame + 1 exists.
-                    if (used[bo] || !on_kept[static_cast<size_t>(leave.to_frame + 1)] ||
-                        leave.from_frame < in.to_frame + 1)
-                        continue;
-                    const double cost = static_cast<double>(in.distance) + leave.distance;
-                    if (cost < best) best = cost, best_in = bi, best_out = bo;
-                }
-            }
-            if (best_in == bridges.size()) continue;
-            for (size_t pick : {best_in, best_out}) {
-                used[pick] = true;
-                chosen.push_back(bridges[pick]);
-                ++out.bridges;
-            }
-            added = true;
-        }
-        if (!added) break;
+        if (round >= kMaxBridgeRounds) break;
+        if (!add_bridges(g, features, pool, chosen, out.bridges)) break;
     }
+}
 
-
-    g.source_hash = graph_source_hash(db.content_hash, params);
-
+void record_stats(MotionGraph& g, const GraphBuildOutput& out, std::int64_t pair_evaluations) {
     std::int64_t kept = 0;
     for (const GraphEdge& e : g.edges)
         if (e.kind == GraphEdgeKind::clip) kept += e.frames;
     g.stats.frames = out.frames;
-    g.stats.pair_evaluations = found.pair_evaluations;
+    g.stats.pair_evaluations = pair_evaluations;
     g.stats.candidates = out.regular_candidates;
     g.stats.nodes_before = out.prune.nodes_before;
     g.stats.edges_before = out.prune.edges_before;
@@ -274,6 +322,28 @@ GraphBuildOutput build_motion_graph(const ClipDatabase& db, const GraphBuildPara
     // Wall time would make the bytes of the same build differ run to run (and the
     // file's bytes enter the simulation's clip-data hash): callers measure it themselves.
     g.stats.build_seconds = 0.0;
+}
+
+}  // namespace
+
+GraphBuildOutput build_motion_graph(const ClipDatabase& db, const GraphBuildParams& params, const GraphBuildHooks& hooks) {
+    GraphBuildOutput out;
+    const int k = params.window_frames;
+    const double leg = skeleton_leg_length(db.skeleton, db.left_foot >= 0 ? db.left_foot : db.right_foot);
+    const std::vector<vec3> positions = database_positions(db);
+    const FrameFeatures features = compute_frame_features(db, positions, k, leg);
+    out.frames = features.frames;
+    const std::int64_t pair_evaluations = search_transitions(features, params, hooks, out);
+    MotionGraph& g = out.graph;
+    copy_clips(db, positions, leg, params, g);
+    std::vector<PlacedTransition> chosen, bridges;
+    for (const PlacedTransition& t : place_candidates(db, positions, features, out.candidates, leg, params))
+        (t.candidate.distance <= out.threshold ? chosen : bridges).push_back(t);
+    out.regular_candidates = static_cast<std::int64_t>(chosen.size());
+    BridgePool pool = make_bridge_pool(std::move(bridges), features, g.clips.size());
+    assemble_with_bridges(g, features, std::move(chosen), std::move(pool), k, out);
+    g.source_hash = graph_source_hash(db.content_hash, params);
+    record_stats(g, out, pair_evaluations);
     return out;
 }
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <stdexcept>
 #include <limits>
 #include <map>
 #include <memory>
@@ -81,10 +82,11 @@ std::vector<vec3> database_positions(const ClipDatabase& db) {
     size_t frame = 0;
     for (const Clip& clip : db.clips)
         for (int f = 0; f < clip.frame_count; ++f, ++frame) {
-            LocalToModelJob fk{db.skeleton.parents, std::span<const quat>(clip.frame_rotations(f), joints),
-                               std::span<const vec3>(clip.frame_translations(f), joints), model_rotations,
-                               std::span<vec3>(out.data() + frame * joints, joints)};
-            fk.run();
+            const LocalToModelJob fk{db.skeleton.parents,
+                                     {std::span<const quat>(clip.frame_rotations(f), joints),
+                                      std::span<const vec3>(clip.frame_translations(f), joints)},
+                                     {model_rotations, std::span<vec3>(out.data() + frame * joints, joints)}};
+            if (!fk.run()) throw std::invalid_argument("clip database skeleton is not in topological order");
         }
     return out;
 }

@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "input/hid/hid_report.hpp"
 #include "input/input_sample.hpp"
 
 namespace marionette::input {
@@ -20,6 +21,17 @@ enum class DeviceFamily : std::uint8_t { ds4, dualsense, switchpro, steamdeck, e
 inline constexpr int kDeviceFamilyCount = 6;
 inline constexpr std::array<std::string_view, kDeviceFamilyCount> kDeviceFamilyNames = {
     "ds4", "dualsense", "switchpro", "steamdeck", "evdev", "sdl"};
+
+// The calibration family of a HID report format (one family per format).
+constexpr DeviceFamily family_of(HidFormat format) {
+    switch (format) {
+        case HidFormat::ds4: return DeviceFamily::ds4;
+        case HidFormat::dualsense: return DeviceFamily::dualsense;
+        case HidFormat::switchpro: return DeviceFamily::switchpro;
+        case HidFormat::steamdeck: return DeviceFamily::steamdeck;
+    }
+    return DeviceFamily::evdev;
+}
 
 struct StickCalibration {
     float centre_x = 0.0f;  // normalised value the stick rests at; subtracted first

@@ -9,12 +9,13 @@
 //
 //   InputRing ring;
 //   InputThread input;
-//   if (!input.start(ring, options, error)) ...;   // backend chosen and opened
+//   if (!input.start(ring, options).ok()) ...;    // backend chosen and opened
 //   ... simulation thread: TickInputAssembler::assemble(ring, t, stats) ...
 //   input.stop();
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <future>
 #include <memory>
 #include <string>
 #include <thread>
@@ -23,6 +24,7 @@
 #include "input/calibration.hpp"
 #include "input/hid/hid_report.hpp"
 #include "input/hid/hid_transport.hpp"
+#include "runtime/errors/outcome.hpp"
 #include "runtime/handoff/spsc_ring.hpp"
 #include "runtime/handoff/tick_input_assembler.hpp"
 
@@ -31,13 +33,19 @@ namespace marionette::input {
 // 4096 samples: 0.5 s at 8 kHz, far more than one tick's worth.
 using InputRing = SpscRing<TimedInput, 4096>;
 
+// A pad the hidraw backend opened: the transport it reads, its report format
+// and its node.
+struct OpenedHidPad {
+    std::unique_ptr<HidTransport> transport;
+    HidFormat format = HidFormat::ds4;
+    std::string path;
+};
+
 // How the hidraw backend reaches a pad: opens `wanted_path` (empty: the first
-// supported pad), sets its format and path, or returns null with `error` set.
-using HidOpener = std::function<std::unique_ptr<HidTransport>(const std::string& wanted_path, HidFormat& format,
-                                                              std::string& path, std::string& error)>;
+// supported pad) into `opened`, or fails saying why.
+using HidOpener = std::function<Outcome(const std::string& wanted_path, OpenedHidPad& opened)>;
 // The default opener: hidapi enumeration and hidraw.
-std::unique_ptr<HidTransport> open_first_hid_pad(const std::string& wanted_path, HidFormat& format, std::string& path,
-                                                std::string& error);
+Outcome open_first_hid_pad(const std::string& wanted_path, OpenedHidPad& opened);
 
 struct InputThreadOptions {
     std::string backend = "auto";         // auto, hidraw, evdev, sdl
@@ -66,8 +74,8 @@ public:
     InputThread& operator=(const InputThread&) = delete;
 
     // Chooses (for "auto") and opens the backend on the new thread, and returns
-    // once it is running (true) or has failed (false, `error` says why).
-    bool start(InputRing& ring, const InputThreadOptions& options, std::string& error);
+    // once it is running (ok) or has failed (saying why).
+    Outcome start(InputRing& ring, const InputThreadOptions& options);
     void stop();
 
     bool running() const { return running_.load(std::memory_order_acquire); }
@@ -80,6 +88,18 @@ public:
     std::thread& thread() { return thread_; }
 
 private:
+    struct HidSession;
+    Outcome choose_backend();
+    void run(InputRing& ring, std::promise<Outcome>& started);
+    void run_evdev(InputRing& ring, std::promise<Outcome>& started);
+    void run_hidraw(InputRing& ring, std::promise<Outcome>& started);
+    void run_sdl(InputRing& ring, std::promise<Outcome>& started);
+    void read_hid_pad(HidSession& hid, InputRingWriter<InputRing>& writer);
+    void reopen_hid_pad(HidSession& hid);
+    // Calibrates `sample` and pushes it, counting it when the ring takes it.
+    void push_calibrated(InputRingWriter<InputRing>& writer, const FamilyCalibration& cal, InputSample& sample);
+    bool stopping() const { return stop_requested_.load(std::memory_order_relaxed); }
+
     std::thread thread_;
     std::atomic<bool> stop_requested_{false};
     std::atomic<bool> running_{false};

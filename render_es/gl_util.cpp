@@ -2,6 +2,8 @@
 
 #include <EGL/egl.h>
 
+#include <algorithm>
+#include <cstddef>
 #include <vector>
 
 namespace marionette::render {
@@ -150,9 +152,26 @@ void RenderTarget::present_to(GLuint target, std::int32_t target_width, std::int
         resolve_to(target, target_width, target_height);
         return;
     }
-    if (single.width != width || single.height != height || single.framebuffer == 0) single.create(width, height, 0);
-    resolve_to(single.framebuffer, width, height);
+    resolve_to_single(single, width, height);
     single.resolve_to(target, target_width, target_height);
+}
+
+void RenderTarget::resolve_to_single(RenderTarget& single, std::int32_t single_width, std::int32_t single_height) const {
+    if (single.width != single_width || single.height != single_height || single.framebuffer == 0)
+        single.create(single_width, single_height, 0);
+    resolve_to(single.framebuffer, single_width, single_height);
+}
+
+void read_rgba_top_down(GLuint framebuffer, std::int32_t width, std::int32_t height, std::vector<std::uint8_t>& rgba) {
+    const size_t row = static_cast<size_t>(width) * 4;
+    rgba.resize(row * static_cast<size_t>(height));
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+    for (size_t top = 0, bottom = static_cast<size_t>(height) - 1; top < bottom; ++top, --bottom)
+        std::swap_ranges(rgba.begin() + static_cast<std::ptrdiff_t>(top * row),
+                         rgba.begin() + static_cast<std::ptrdiff_t>((top + 1) * row),
+                         rgba.begin() + static_cast<std::ptrdiff_t>(bottom * row));
 }
 
 }  // namespace marionette::render

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace marionette::render {
 
@@ -39,12 +40,24 @@ struct RenderTarget {
     void destroy();
     // Forgets the GL names without deleting them (their context is gone).
     void abandon() { *this = RenderTarget{}; }
+    // destroy() while the target's context is current on this thread, else
+    // abandon(): the context is gone or another thread's, so its names cannot be deleted here.
+    void release(bool context_current) {
+        if (context_current) destroy();
+        else abandon();
+    }
     void resolve_to(GLuint target, std::int32_t target_width, std::int32_t target_height) const;
+    // Resolves into `single` (single-sample RGBA8 of width × height, (re)created as needed).
+    void resolve_to_single(RenderTarget& single, std::int32_t single_width, std::int32_t single_height) const;
     // Copies the frame to `target` (a window's framebuffer 0): a multisampled
     // target resolves into `single` (same RGBA8 format, (re)created as needed)
     // first, since GLES forbids a multisample resolve into a different format.
     void present_to(GLuint target, std::int32_t target_width, std::int32_t target_height, RenderTarget& single) const;
 };
+
+// Reads `framebuffer` (single-sample RGBA8, width × height) into `rgba`, top
+// row first (GL's first row is the bottom one; images start at the top).
+void read_rgba_top_down(GLuint framebuffer, std::int32_t width, std::int32_t height, std::vector<std::uint8_t>& rgba);
 
 // Clamps a requested MSAA sample count to what the context supports (0 = off).
 std::int32_t supported_samples(std::int32_t requested);

@@ -134,10 +134,9 @@ SkinnedMesh make_capsule_mesh(const Skeleton& skeleton, const CapsuleMeshSetting
     const Pose rest = rest_pose(skeleton);
     std::vector<quat> model_rotations(static_cast<size_t>(n));
     std::vector<vec3> model_positions(static_cast<size_t>(n));
-    LocalToModelJob fk{skeleton.parents, rest.local_rotations, rest.local_translations, model_rotations,
-                       model_positions};
-    if (!fk.validate()) throw std::invalid_argument("skeleton is not in topological order");
-    fk.run();
+    const LocalToModelJob fk{skeleton.parents, {rest.local_rotations, rest.local_translations},
+                             {model_rotations, model_positions}};
+    if (!fk.run()) throw std::invalid_argument("skeleton is not in topological order");
 
     SkinnedMesh mesh;
     for (int j = 0; j < n; ++j)

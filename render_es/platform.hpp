@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "runtime/errors/outcome.hpp"
+
 namespace marionette::render {
 
 // A platform could not be opened (no display, no DRM device, no permission, no
@@ -70,7 +72,7 @@ struct KmsModeRequest {
 struct KmsChoice {
     int connector_index = -1;
     int mode_index = -1;
-    std::string error;             // empty when a connector and mode were chosen
+    Outcome chosen = Outcome::success();  // fails naming what is missing
 };
 
 // Connector: the named one (it must be connected) or the first connected one.
@@ -133,6 +135,19 @@ public:
     // Human-readable "EGL 1.5, OpenGL ES 3.2 Mesa ..., llvmpipe ..."
     virtual std::string description() const = 0;
 };
+
+// recover()'s shape on every platform: tear the context down, then build it
+// again; false when building throws.
+template <typename Teardown, typename Build>
+bool rebuild(Teardown&& teardown, Build&& build) {
+    teardown();
+    try {
+        build();
+    } catch (const std::exception&) {
+        return false;
+    }
+    return true;
+}
 
 // Opens the platform options.kind names. Throws PlatformError.
 std::unique_ptr<Platform> open_platform(const PlatformOptions& options);

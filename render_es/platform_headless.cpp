@@ -77,27 +77,10 @@ public:
 
     PlatformEvents poll_events() override { return {}; }
 
-    bool recover() override {
-        release_context();
-        try {
-            create_context();
-        } catch (const std::exception&) {
-            return false;
-        }
-        return true;
-    }
+    bool recover() override { return rebuild([this] { release_context(); }, [this] { create_context(); }); }
 
     void read_pixels(std::vector<std::uint8_t>& rgba) override {
-        const size_t row = static_cast<size_t>(options_.width) * 4;
-        rgba.resize(row * static_cast<size_t>(options_.height));
-        glBindFramebuffer(GL_READ_FRAMEBUFFER, resolved_.framebuffer);
-        glPixelStorei(GL_PACK_ALIGNMENT, 1);
-        glReadPixels(0, 0, options_.width, options_.height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
-        // GL's first row is the bottom one; images start at the top.
-        for (size_t top = 0, bottom = static_cast<size_t>(options_.height) - 1; top < bottom; ++top, --bottom)
-            std::swap_ranges(rgba.begin() + static_cast<std::ptrdiff_t>(top * row),
-                             rgba.begin() + static_cast<std::ptrdiff_t>((top + 1) * row),
-                             rgba.begin() + static_cast<std::ptrdiff_t>(bottom * row));
+        read_rgba_top_down(resolved_.framebuffer, options_.width, options_.height, rgba);
     }
 
     std::string description() const override { return "headless (" + which_ + ") " + egl_ + ", " + gl_; }
@@ -116,13 +99,9 @@ private:
 
     void release_context() {
         if (context_ == EGL_NO_CONTEXT) return;
-        if (eglGetCurrentContext() == context_) {
-            draw_.destroy();
-            resolved_.destroy();
-        } else {
-            draw_.abandon();
-            resolved_.abandon();
-        }
+        const bool current = eglGetCurrentContext() == context_;
+        draw_.release(current);
+        resolved_.release(current);
         eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
         eglDestroyContext(display_, context_);
         context_ = EGL_NO_CONTEXT;

@@ -126,9 +126,9 @@ Scanout choose_scanout(int fd, const KmsModeRequest& request, const std::string&
         drmModeFreeConnector(c);
     }
     const KmsChoice choice = choose_kms_mode(s.connectors, request);
-    if (!choice.error.empty()) {
+    if (!choice.chosen.ok()) {
         drmModeFreeResources(res);
-        fail(device + ": " + choice.error);
+        fail(device + ": " + choice.chosen.problem());
     }
     const KmsConnector& chosen = s.connectors[static_cast<size_t>(choice.connector_index)];
     s.connector_id = chosen.id;
@@ -264,29 +264,11 @@ public:
         return e;
     }
 
-    bool recover() override {
-        close_display();
-        try {
-            open_display();
-        } catch (const std::exception&) {
-            return false;
-        }
-        return true;
-    }
+    bool recover() override { return rebuild([this] { close_display(); }, [this] { open_display(); }); }
 
     void read_pixels(std::vector<std::uint8_t>& rgba) override {
-        const size_t row = static_cast<size_t>(width()) * 4;
-        rgba.resize(row * static_cast<size_t>(height()));
-        if (resolved_.width != width() || resolved_.height != height() || resolved_.framebuffer == 0)
-            resolved_.create(width(), height(), 0);
-        draw_.resolve_to(resolved_.framebuffer, width(), height());
-        glBindFramebuffer(GL_READ_FRAMEBUFFER, resolved_.framebuffer);
-        glPixelStorei(GL_PACK_ALIGNMENT, 1);
-        glReadPixels(0, 0, width(), height(), GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
-        for (size_t top = 0, bottom = static_cast<size_t>(height()) - 1; top < bottom; ++top, --bottom)
-            std::swap_ranges(rgba.begin() + static_cast<std::ptrdiff_t>(top * row),
-                             rgba.begin() + static_cast<std::ptrdiff_t>((top + 1) * row),
-                             rgba.begin() + static_cast<std::ptrdiff_t>(bottom * row));
+        draw_.resolve_to_single(resolved_, width(), height());
+        read_rgba_top_down(resolved_.framebuffer, width(), height(), rgba);
     }
 
     std::string description() const override {
@@ -337,13 +319,9 @@ private:
             saved_crtc_ = nullptr;
         }
         if (egl_display_ != EGL_NO_DISPLAY) {
-            if (eglGetCurrentContext() == context_) {
-                draw_.destroy();
-                resolved_.destroy();
-            } else {
-                draw_.abandon();
-                resolved_.abandon();
-            }
+            const bool current = eglGetCurrentContext() == context_;
+            draw_.release(current);
+            resolved_.release(current);
             eglMakeCurrent(egl_display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
             if (surface_ != EGL_NO_SURFACE) eglDestroySurface(egl_display_, surface_);
             if (context_ != EGL_NO_CONTEXT) eglDestroyContext(egl_display_, context_);

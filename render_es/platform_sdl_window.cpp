@@ -98,31 +98,13 @@ public:
         return e;
     }
 
-    bool recover() override {
-        release_context();
-        try {
-            create_context();
-        } catch (const std::exception&) {
-            return false;
-        }
-        return true;
-    }
+    bool recover() override { return rebuild([this] { release_context(); }, [this] { create_context(); }); }
 
     void read_pixels(std::vector<std::uint8_t>& rgba) override {
         // The window's back buffer is undefined after the swap; the frame is still
         // in the draw target, so resolve that into a single-sample copy and read it.
-        if (resolved_.width != width_ || resolved_.height != height_ || resolved_.framebuffer == 0)
-            resolved_.create(width_, height_, 0);
-        draw_.resolve_to(resolved_.framebuffer, width_, height_);
-        const size_t row = static_cast<size_t>(width_) * 4;
-        rgba.resize(row * static_cast<size_t>(height_));
-        glBindFramebuffer(GL_READ_FRAMEBUFFER, resolved_.framebuffer);
-        glPixelStorei(GL_PACK_ALIGNMENT, 1);
-        glReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
-        for (size_t top = 0, bottom = static_cast<size_t>(height_) - 1; top < bottom; ++top, --bottom)
-            std::swap_ranges(rgba.begin() + static_cast<std::ptrdiff_t>(top * row),
-                             rgba.begin() + static_cast<std::ptrdiff_t>((top + 1) * row),
-                             rgba.begin() + static_cast<std::ptrdiff_t>(bottom * row));
+        draw_.resolve_to_single(resolved_, width_, height_);
+        read_rgba_top_down(resolved_.framebuffer, width_, height_, rgba);
     }
 
     std::string description() const override {
@@ -149,13 +131,9 @@ private:
 
     void release_context() {
         if (context_ == nullptr) return;
-        if (SDL_GL_GetCurrentContext() == context_) {
-            draw_.destroy();
-            resolved_.destroy();
-        } else {
-            draw_.abandon();
-            resolved_.abandon();
-        }
+        const bool current = SDL_GL_GetCurrentContext() == context_;
+        draw_.release(current);
+        resolved_.release(current);
         SDL_GL_DeleteContext(context_);
         context_ = nullptr;
     }

@@ -82,7 +82,7 @@ KmsChoice choose_kms_mode(std::span<const KmsConnector> connectors, const KmsMod
         if (!request.connector.empty()) {
             if (c.name != request.connector) continue;
             if (!c.connected) {
-                choice.error = "connector " + c.name + " has no display connected";
+                choice.chosen = Outcome::failure("connector " + c.name + " has no display connected");
                 return choice;
             }
         }
@@ -91,8 +91,8 @@ KmsChoice choose_kms_mode(std::span<const KmsConnector> connectors, const KmsMod
         break;
     }
     if (choice.connector_index < 0) {
-        choice.error = request.connector.empty() ? std::string("no connector has a display connected")
-                                                 : "no connector named " + request.connector;
+        choice.chosen = Outcome::failure(request.connector.empty() ? std::string("no connector has a display connected")
+                                                                   : "no connector named " + request.connector);
         return choice;
     }
     const std::vector<KmsMode>& modes = connectors[static_cast<size_t>(choice.connector_index)].modes;
@@ -108,9 +108,10 @@ KmsChoice choose_kms_mode(std::span<const KmsConnector> connectors, const KmsMod
             consider(static_cast<int>(i), faster_then_larger);
         }
         if (best < 0) {
-            choice.error = "connector " + connectors[static_cast<size_t>(choice.connector_index)].name +
-                           " offers no mode " + std::to_string(request.width) + "x" + std::to_string(request.height) +
-                           (request.refresh_hz > 0 ? "@" + std::to_string(request.refresh_hz) + "Hz" : std::string());
+            choice.chosen = Outcome::failure(
+                "connector " + connectors[static_cast<size_t>(choice.connector_index)].name + " offers no mode " +
+                std::to_string(request.width) + "x" + std::to_string(request.height) +
+                (request.refresh_hz > 0 ? "@" + std::to_string(request.refresh_hz) + "Hz" : std::string()));
             return choice;
         }
     } else if (request.policy == KmsModePolicy::highest_refresh) {

@@ -9,6 +9,8 @@
 #include <cstddef>
 #include <cstdio>
 #include <cstring>
+#include <initializer_list>
+#include <vector>
 
 #include "render_es/gl_util.hpp"
 #include "render_es/shaders.hpp"
@@ -22,6 +24,44 @@ const vec3 kSun = glm::normalize(vec3(-0.55f, 0.75f, 0.35f));
 constexpr GLuint kBonesBinding = 0;
 
 void* offset(std::size_t bytes) { return reinterpret_cast<void*>(bytes); }
+
+// Binds `vao` and fills its vertex and index buffers once, for many draws.
+template <typename Vertex, typename Index>
+void upload_static_mesh(GLuint vao, GLuint vbo, const std::vector<Vertex>& vertices, GLuint ibo,
+                        const std::vector<Index>& indices) {
+    glBindVertexArray(vao);
+    glBindBuffer(GL_ARRAY_BUFFER, vbo);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data(),
+                 GL_STATIC_DRAW);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(Index)), indices.data(),
+                 GL_STATIC_DRAW);
+}
+
+// How the vertex shader reads an attribute: as floats (normalised from integers
+// or not) or as integers.
+enum class AttributeRead { as_float, normalized, as_integer };
+
+struct VertexAttribute {
+    GLint components;
+    GLenum type;
+    AttributeRead read;
+    std::size_t offset;  // bytes into the vertex
+};
+
+// Attribute i of the bound VAO reads attributes[i] from vertices `stride` bytes apart.
+void set_vertex_attributes(GLsizei stride, std::initializer_list<VertexAttribute> attributes) {
+    GLuint index = 0;
+    for (const VertexAttribute& a : attributes) {
+        glEnableVertexAttribArray(index);
+        if (a.read == AttributeRead::as_integer)
+            glVertexAttribIPointer(index, a.components, a.type, stride, offset(a.offset));
+        else
+            glVertexAttribPointer(index, a.components, a.type, a.read == AttributeRead::normalized ? GL_TRUE : GL_FALSE,
+                                  stride, offset(a.offset));
+        ++index;
+    }
+}
 
 void set_colours(GLuint program, const char* name, const vec3* colours, int count) {
     glUniform3fv(glGetUniformLocation(program, name), count, glm::value_ptr(colours[0]));
@@ -69,24 +109,13 @@ void Renderer::create_gl() {
     glGenVertexArrays(1, &puppet_vao_);
     glGenBuffers(1, &puppet_vbo_);
     glGenBuffers(1, &puppet_ibo_);
-    glBindVertexArray(puppet_vao_);
-    glBindBuffer(GL_ARRAY_BUFFER, puppet_vbo_);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(puppet_.vertices.size() * sizeof(SkinnedVertex)),
-                 puppet_.vertices.data(), GL_STATIC_DRAW);
-    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, puppet_ibo_);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(puppet_.indices.size() * sizeof(std::uint16_t)),
-                 puppet_.indices.data(), GL_STATIC_DRAW);
-    constexpr GLsizei stride = sizeof(SkinnedVertex);
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride, offset(offsetof(SkinnedVertex, position)));
-    glEnableVertexAttribArray(1);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride, offset(offsetof(SkinnedVertex, normal)));
-    glEnableVertexAttribArray(2);
-    glVertexAttribIPointer(2, 4, GL_UNSIGNED_BYTE, stride, offset(offsetof(SkinnedVertex, joints)));
-    glEnableVertexAttribArray(3);
-    glVertexAttribPointer(3, 4, GL_FLOAT, GL_FALSE, stride, offset(offsetof(SkinnedVertex, weights)));
-    glEnableVertexAttribArray(4);
-    glVertexAttribPointer(4, 1, GL_UNSIGNED_BYTE, GL_FALSE, stride, offset(offsetof(SkinnedVertex, part)));
+    upload_static_mesh(puppet_vao_, puppet_vbo_, puppet_.vertices, puppet_ibo_, puppet_.indices);
+    set_vertex_attributes(sizeof(SkinnedVertex),
+                          {{3, GL_FLOAT, AttributeRead::as_float, offsetof(SkinnedVertex, position)},
+                           {3, GL_FLOAT, AttributeRead::as_float, offsetof(SkinnedVertex, normal)},
+                           {4, GL_UNSIGNED_BYTE, AttributeRead::as_integer, offsetof(SkinnedVertex, joints)},
+                           {4, GL_FLOAT, AttributeRead::as_float, offsetof(SkinnedVertex, weights)},
+                           {1, GL_UNSIGNED_BYTE, AttributeRead::as_float, offsetof(SkinnedVertex, part)}});
 
     glGenBuffers(1, &bones_ubo_);
     glBindBuffer(GL_UNIFORM_BUFFER, bones_ubo_);
@@ -104,10 +133,8 @@ void Renderer::create_gl() {
     glBindVertexArray(line_vao_);
     glBindBuffer(GL_ARRAY_BUFFER, line_vbo_);
     glBufferData(GL_ARRAY_BUFFER, kMaxLineVertices * sizeof(LineVertex), nullptr, GL_STREAM_DRAW);
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(LineVertex), offset(offsetof(LineVertex, position)));
-    glEnableVertexAttribArray(1);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(LineVertex), offset(offsetof(LineVertex, colour)));
+    set_vertex_attributes(sizeof(LineVertex), {{3, GL_FLOAT, AttributeRead::as_float, offsetof(LineVertex, position)},
+                                               {3, GL_FLOAT, AttributeRead::as_float, offsetof(LineVertex, colour)}});
 
     // HUD quads → triangles through a fixed index buffer.
     glGenVertexArrays(1, &hud_vao_);
@@ -126,28 +153,16 @@ void Renderer::create_gl() {
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, hud_ibo_);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(quad_indices.size() * sizeof(std::uint16_t)),
                  quad_indices.data(), GL_STATIC_DRAW);
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, sizeof(HudVertex), offset(offsetof(HudVertex, x)));
-    glEnableVertexAttribArray(1);
-    glVertexAttribPointer(1, 4, GL_UNSIGNED_BYTE, GL_TRUE, sizeof(HudVertex), offset(offsetof(HudVertex, colour)));
+    set_vertex_attributes(sizeof(HudVertex), {{2, GL_FLOAT, AttributeRead::as_float, offsetof(HudVertex, x)},
+                                              {4, GL_UNSIGNED_BYTE, AttributeRead::normalized, offsetof(HudVertex, colour)}});
     glBindVertexArray(0);
 }
 
 void Renderer::upload_terrain() {
-    glBindVertexArray(terrain_vao_);
-    glBindBuffer(GL_ARRAY_BUFFER, terrain_vbo_);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(terrain_.vertices.size() * sizeof(TerrainVertex)),
-                 terrain_.vertices.data(), GL_STATIC_DRAW);
-    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, terrain_ibo_);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(terrain_.indices.size() * sizeof(std::uint32_t)),
-                 terrain_.indices.data(), GL_STATIC_DRAW);
-    constexpr GLsizei stride = sizeof(TerrainVertex);
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride, offset(offsetof(TerrainVertex, position)));
-    glEnableVertexAttribArray(1);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride, offset(offsetof(TerrainVertex, normal)));
-    glEnableVertexAttribArray(2);
-    glVertexAttribPointer(2, 1, GL_FLOAT, GL_FALSE, stride, offset(offsetof(TerrainVertex, part)));
+    upload_static_mesh(terrain_vao_, terrain_vbo_, terrain_.vertices, terrain_ibo_, terrain_.indices);
+    set_vertex_attributes(sizeof(TerrainVertex), {{3, GL_FLOAT, AttributeRead::as_float, offsetof(TerrainVertex, position)},
+                                                  {3, GL_FLOAT, AttributeRead::as_float, offsetof(TerrainVertex, normal)},
+                                                  {1, GL_FLOAT, AttributeRead::as_float, offsetof(TerrainVertex, part)}});
     glBindVertexArray(0);
 }
 

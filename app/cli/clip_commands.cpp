@@ -10,22 +10,14 @@
 #include "app/io/json.hpp"
 #include "runtime/formats/asf_amc.hpp"
 #include "runtime/formats/bvh.hpp"
+#include "runtime/formats/file_names.hpp"
 
 namespace marionette {
 
 namespace {
-std::string extension_of(const std::string& path) {
-    const size_t dot = path.find_last_of('.');
-    const size_t slash = path.find_last_of('/');
-    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return {};
-    std::string ext = path.substr(dot + 1);
-    for (char& c : ext) c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
-    return ext;
-}
-
 // BVH, AMC (with its ASF) or a bare ASF (skeleton only, zero frames).
 Clip load_clip(const ClipOptions& o) {
-    const std::string ext = extension_of(o.file);
+    const std::string ext = lower_extension(o.file);
     if (ext == "bvh") return load_bvh_file(o.file);
     if (ext == "amc") {
         if (o.asf_file.empty()) throw ImportError(o.file, 0, "an AMC file needs its skeleton: add --asf SKELETON.asf");
@@ -42,7 +34,7 @@ Clip load_clip(const ClipOptions& o) {
 }
 
 std::string format_name(const std::string& path) {
-    const std::string ext = extension_of(path);
+    const std::string ext = lower_extension(path);
     return ext == "bvh" ? "bvh" : (ext == "amc" ? "asf/amc" : "asf");
 }
 }  // namespace
@@ -75,9 +67,12 @@ int clip_fk_command(const ClipOptions& o) {
     const size_t n = static_cast<size_t>(clip.joint_count());
     std::vector<quat> model_rotations(n);
     std::vector<vec3> model_positions(n);
-    LocalToModelJob fk{clip.skeleton.parents, std::span<const quat>(clip.frame_rotations(o.frame), n),
-                       std::span<const vec3>(clip.frame_translations(o.frame), n), model_rotations, model_positions};
-    fk.run();
+    const LocalToModelJob fk{clip.skeleton.parents,
+                             {std::span<const quat>(clip.frame_rotations(o.frame), n),
+                              std::span<const vec3>(clip.frame_translations(o.frame), n)},
+                             {model_rotations, model_positions}};
+    // The importers validate the skeleton, so this holds for every loaded clip.
+    if (!fk.run()) throw ImportError(o.file, 0, "the skeleton's parents are not in topological order");
     const Skeleton& s = clip.skeleton;
     if (o.json) {
         std::string out = "{\"joints\":[";

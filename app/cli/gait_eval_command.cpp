@@ -27,21 +27,22 @@ struct GaitEvalOptions {
 };
 
 int gait_eval_command(const GaitEvalOptions& o) {
-    SimConfig config = load_config(o.config_file);
+    const AppConfig app = load_config(o.config_file);
+    SimConfig config = app.sim;
     if (!o.terrain.empty()) {
         config.terrain = load_terrain(o.terrain);
         config.terrain_name = o.terrain;
     }
     const StickProgram program = load_program(o.program);
     // No --graph with [motion] source = graph/graph_feet: the embedded default graph.
-    auto graph = load_graph_argument(o.graph_file, config);
+    auto graph = load_graph_argument(o.graph_file, config, app.graph_build);
     const bool with_graph = graph != nullptr;
     const std::string graph_name = o.graph_file.empty() ? std::string("default") : o.graph_file;
     const GaitMetrics m = evaluate_gait(config, program, o.feet_csv, std::move(graph));
     // The limits are the procedural gait's (docs/gait.md). A graph plays captured
     // motion without contact pinning yet, so with --graph the metrics are reported
     // and only a metric that is not a finite number fails --check.
-    const std::string failures = with_graph ? gait_metric_non_finite(m) : gait_limit_failures(m);
+    const Outcome checked = with_graph ? check_gait_metrics_finite(m) : check_gait_limits(m);
     if (o.json) {
         fmt::print("{{\"terrain\":{},\"program\":{},\"motion_source\":{},\"graph\":{},\"ticks\":{},\"foot_skate_mm\":{},"
                    "\"penetration_mm\":{},\"speed_error_pct\":{},\"speed_expectation\":{},\"speed_windows\":{},"
@@ -50,7 +51,7 @@ int gait_eval_command(const GaitEvalOptions& o) {
                    with_graph ? json::quote(graph_name) : std::string("null"), m.ticks, json::number(m.foot_skate_mm),
                    json::number(m.penetration_mm), json::number(m.speed_error_pct), json::quote(m.speed_expectation),
                    m.speed_windows, json::number(m.max_joint_speed_deg_s), m.steps, m.flight_phases, m.final_hash,
-                   with_graph ? "null" : failures.empty() ? "true" : "false");
+                   with_graph ? "null" : checked.ok() ? "true" : "false");
     } else {
         fmt::print("gait-eval: {} on {} ({} ticks, motion from {})\n", o.program, config.terrain_name, m.ticks,
                    with_graph ? m.motion_source + " from graph " + graph_name : std::string("the gait"));
@@ -63,10 +64,10 @@ int gait_eval_command(const GaitEvalOptions& o) {
         fmt::print("  max_joint_speed_deg_s  {:10.1f}  (limit < {}; {} at tick {})\n", m.max_joint_speed_deg_s, kMaxJointSpeedDegS,
                    m.fastest_joint, m.fastest_joint_tick);
         fmt::print("  steps {}  flight_phases {}  final hash {:016x}\n", m.steps, m.flight_phases, m.final_hash);
-        if (!failures.empty()) fmt::print("  {}: {}\n", with_graph ? "NOT FINITE" : "LIMITS BROKEN", failures);
+        if (!checked.ok()) fmt::print("  {}: {}\n", with_graph ? "NOT FINITE" : "LIMITS BROKEN", checked.problem());
     }
-    if (o.check && !failures.empty()) {
-        fmt::print(stderr, "gait-eval: {} on {}: {}\n", o.program, config.terrain_name, failures);
+    if (o.check && !checked.ok()) {
+        fmt::print(stderr, "gait-eval: {} on {}: {}\n", o.program, config.terrain_name, checked.problem());
         return 1;
     }
     return 0;

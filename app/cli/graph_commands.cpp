@@ -181,10 +181,10 @@ std::string kept_range(const MotionGraph& g, int clip) {
 int graph_default_build_command(const GraphBuildCommandOptions& o) {
     if (!o.clip_files.empty() || !o.asf_file.empty() || !o.labels_file.empty())
         throw ImportError("command line", 0, "--default builds the embedded clips: give no CLIPS, --asf or --labels with it");
-    const SimConfig config = load_config(o.config_file);
+    const AppConfig config = load_config(o.config_file);
     offline::GraphBuildHooks hooks;
     if (!o.plot_file.empty()) hooks.plot_size = 1024;
-    const DefaultGraphBuild build = build_default_motion_graph_report(config, hooks);
+    const DefaultGraphBuild build = build_default_motion_graph_report(config.sim, config.graph_build, hooks);
     const offline::GraphBuildOutput& out = build.output;
     const MotionGraph& g = out.graph;
     write_binary_file(o.output_file, serialize_motion_graph(g));
@@ -220,9 +220,9 @@ int graph_build_command(const GraphBuildCommandOptions& o) {
     if (o.default_graph) return graph_default_build_command(o);
     if (o.clip_files.empty())
         throw ImportError("command line", 0, "graph build needs CLIPS (.bvh, or .amc with --asf), or --default");
-    const SimConfig config = load_config(o.config_file);
+    const GraphBuildConfig build_config = load_config(o.config_file).graph_build;
     const GraphSources sources{o.asf_file, o.clip_files, o.labels_file};
-    offline::GraphBuildParams params = graph_build_params(config);
+    offline::GraphBuildParams params = graph_build_params(build_config);
     params.threads = o.threads;
     const auto started = std::chrono::steady_clock::now();
     const offline::ClipDatabase db = load_graph_sources(sources, params.analysis_rate_hz);
@@ -320,7 +320,7 @@ int graph_info_command(const GraphInfoOptions& o) {
 }
 
 int graph_path_command(const GraphPathOptions& o) {
-    const SimConfig config = load_config(o.config_file);
+    const SimConfig config = load_config(o.config_file).sim;
     const MotionGraph g = load_motion_graph_file(o.graph_file);
     const auto [from_clip, from_frame] = parse_clip_frame(g, o.from, "--from");
     if (from_clip < 0) throw ImportError("--from", 0, "'" + o.from + "': expected CLIP:FRAME");

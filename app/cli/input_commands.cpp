@@ -50,16 +50,6 @@ std::string sample_line(const InputSample& s, bool as_json) {
                        s.lx, s.ly, s.rx, s.ry, s.lt, s.rt, names);
 }
 
-DeviceFamily family_of(HidFormat f) {
-    switch (f) {
-        case HidFormat::ds4: return DeviceFamily::ds4;
-        case HidFormat::dualsense: return DeviceFamily::dualsense;
-        case HidFormat::switchpro: return DeviceFamily::switchpro;
-        case HidFormat::steamdeck: return DeviceFamily::steamdeck;
-    }
-    return DeviceFamily::evdev;
-}
-
 // ---- input decode ---------------------------------------------------------------
 
 struct DecodeOptions {
@@ -160,10 +150,9 @@ int monitor_command(const MonitorOptions& o) {
 
     if (*kind == BackendKind::evdev) {
         EvdevBackend evdev;
-        std::string error;
-        const bool ok = o.device.empty() ? evdev.watch_directory(o.evdev_dir, error) : evdev.open_device(o.device, error);
-        if (!ok) {
-            fmt::print(stderr, "error: {}\n", error);
+        const Outcome opened = o.device.empty() ? evdev.watch_directory(o.evdev_dir) : evdev.open_device(o.device);
+        if (!opened.ok()) {
+            fmt::print(stderr, "error: {}\n", opened.problem());
             return 1;
         }
         evdev.set_raw(o.raw);
@@ -217,9 +206,8 @@ int monitor_command(const MonitorOptions& o) {
         if (pad.counters().rejected() > 0) fmt::print(stderr, "input: {} reports rejected\n", pad.counters().rejected());
     } else {
         SdlBackend sdl;
-        std::string error;
-        if (!sdl.start(config.sdl_mapping_file, error)) {
-            fmt::print(stderr, "error: {}\n", error);
+        if (const Outcome started = sdl.start(config.sdl_mapping_file); !started.ok()) {
+            fmt::print(stderr, "error: {}\n", started.problem());
             return 1;
         }
         fmt::print(stderr, "input: sdl: {} joystick(s), {} mapping(s) loaded{}\n", sdl.joysticks(), sdl.mappings_loaded(),
@@ -252,8 +240,7 @@ int list_command(const ListOptions& o) {
     std::vector<Row> rows;
     {
         EvdevBackend evdev;
-        std::string error;
-        if (evdev.watch_directory(o.evdev_dir, error) && evdev.connected() > 0) {
+        if (evdev.watch_directory(o.evdev_dir).ok() && evdev.connected() > 0) {
             std::array<std::uint64_t, EvdevBackend::kMaxPads> frames{};
             std::array<InputSample, 64> batch{};
             const auto start = std::chrono::steady_clock::now();

@@ -14,13 +14,14 @@
 namespace marionette {
 
 int record_command(const RecordOptions& o) {
-    const SimConfig config = load_config(o.config_file);
+    const AppConfig app = load_config(o.config_file);
+    const SimConfig& config = app.sim;
     const StickProgram program = load_program(o.program_file);
     const std::vector<TickInput> ticks = render_stick_program(program, config.tick_rate_hz);
 
     set_simulation_float_mode();
     Simulation sim(config);
-    if (auto graph = load_graph_argument_rebuilding_stale(o.graph_file, config))
+    if (auto graph = load_graph_argument_rebuilding_stale(o.graph_file, config, app.graph_build))
         attach_motion_graph(sim, std::move(graph), o.graph_file.empty() ? "the default motion graph" : "graph " + o.graph_file);
     InputLogHeader header;
     header.tick_rate_hz = static_cast<std::uint32_t>(config.tick_rate_hz);
@@ -55,8 +56,8 @@ int replay_command(const ReplayCommandOptions& o) {
     options.bvh = o.bvh;
     // Never rebuilds a stale graph (unlike run/record): a rebuilt graph has other
     // bytes than the one recorded, so the log's clip hash would refuse it.
-    options.graph = load_graph_argument(
-        o.graph_file, config_from_text(log.header.config_text, o.log_file + " (embedded configuration)"));
+    const AppConfig recorded = config_from_text(log.header.config_text, o.log_file + " (embedded configuration)");
+    options.graph = load_graph_argument(o.graph_file, recorded.sim, recorded.graph_build);
     const ReplayResult r = replay_log(log, o.log_file, options);
     if (o.json) {
         fmt::print("{{\"log\":{},\"ticks\":{},\"tick_rate_hz\":{},\"duration_s\":{},\"final_hash\":\"{:016x}\","

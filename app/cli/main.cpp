@@ -3,8 +3,7 @@
 #include <fmt/format.h>
 
 #include "app/cli/cli.hpp"
-#include "app/config/config.hpp"
-#include "runtime/errors/import_error.hpp"
+#include "runtime/errors/parse_error.hpp"
 
 int main(int argc, char** argv) {
     using namespace marionette;
@@ -23,10 +22,7 @@ int main(int argc, char** argv) {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
-    } catch (const ImportError& e) {
-        fmt::print(stderr, "error: {}\n", e.what());
-        return 2;
-    } catch (const ConfigError& e) {
+    } catch (const ParseError& e) {  // a bad file, configuration or option value
         fmt::print(stderr, "error: {}\n", e.what());
         return 2;
     } catch (const std::exception& e) {

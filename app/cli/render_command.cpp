@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <sys/wait.h>
 
@@ -45,7 +46,8 @@ bool parse_size(const std::string& text, std::int32_t& w, std::int32_t& h) {
     return true;
 }
 
-std::string find_on_path(const std::string& program) {
+// The executable `program` on $PATH, if there is one.
+std::optional<std::string> find_on_path(const std::string& program) {
     const char* path = std::getenv("PATH");
     std::stringstream dirs(path ? path : "");
     std::string dir;
@@ -54,7 +56,7 @@ std::string find_on_path(const std::string& program) {
         std::error_code ec;
         if (std::filesystem::is_regular_file(candidate, ec) && access(candidate.c_str(), X_OK) == 0) return candidate.string();
     }
-    return {};
+    return std::nullopt;
 }
 
 void apply_overlay_list(const std::string& list, render::RenderSettings& s) {
@@ -111,10 +113,11 @@ int render_command(const RenderCommandOptions& o) {
         throw ImportError("--to", 0, fmt::format("--to {} is before --from {}", o.to_s, o.from_s));
     std::string ffmpeg;
     if (!o.video.empty()) {
-        ffmpeg = find_on_path("ffmpeg");
-        if (ffmpeg.empty())
+        const std::optional<std::string> found = find_on_path("ffmpeg");
+        if (!found)
             throw std::runtime_error("--video " + o.video + " needs ffmpeg, which is not installed (apt-get install ffmpeg); "
                                      "PNG frames (--out DIR) need nothing");
+        ffmpeg = *found;
     }
     const DecodedInputLog log = decode_input_log(read_binary_file(o.log_file), o.log_file);
     if (!log.warning.empty()) fmt::print(stderr, "warning: {}\n", log.warning);

@@ -75,142 +75,139 @@ void write_stats_json(const std::string& path, const RunOptions& o, const SimCon
                       "time");
 }
 
-// Why the backend named on the command line has no pad to read (empty: it has
-// one). Checked before the run starts so the error is immediate and exits 2.
-std::string missing_pad(const std::string& backend, const std::string& evdev_dir) {
+// Ok when the backend named on the command line has a pad to read, else why not.
+// Checked before the run starts so the error is immediate and exits 2.
+Outcome find_pad(const std::string& backend, const std::string& evdev_dir) {
     if (backend == "evdev") {
         if (input::enumerate_evdev_gamepads(evdev_dir).empty())
-            return "no gamepad under " + evdev_dir + " (is it plugged in and readable? see `marionette input list`)";
+            return Outcome::failure("no gamepad under " + evdev_dir + " (is it plugged in and readable? see `marionette input list`)");
     } else if (backend == "hidraw") {
         if (input::enumerate_hid_pads().empty())
-            return "no supported HID pad found (see `marionette input list`)";
+            return Outcome::failure("no supported HID pad found (see `marionette input list`)");
     } else if (backend == "sdl") {
         input::SdlBackend sdl;
-        std::string error;
-        if (!sdl.start("", error)) return "SDL2 cannot start: " + error;
-        if (sdl.joysticks() == 0) return "SDL2 sees no joystick";
+        if (const Outcome started = sdl.start(""); !started.ok()) return Outcome::failure("SDL2 cannot start: " + started.problem());
+        if (sdl.joysticks() == 0) return Outcome::failure("SDL2 sees no joystick");
     }
-    return {};
+    return Outcome::success();
 }
 
-}  // namespace
-
-int run_command(const RunOptions& o) {
-    SimConfig config = load_config(o.config_file);
-    PipelineOptions p;
-    std::string source;
-    std::string input = o.input;
-    input::InputThreadOptions device;
+// What --input resolved to: "auto" probes for a controller (input/auto_select.hpp)
+// and falls back to the simulated controller playing the demo.
+struct InputChoice {
+    std::string input;
     bool use_device = false;
-    if (input == "auto") {
-        // A controller if one is there (input/auto_select.hpp), else the
-        // simulated controller plays the demo.
+};
+
+InputChoice choose_input(const RunOptions& o, input::InputThreadOptions& device) {
+    InputChoice c{o.input, false};
+    if (c.input == "auto") {
         const input::BackendChoice choice = input::probe_input_backend(device.evdev_dir);
         if (choice.kind == input::BackendKind::none) {
             fmt::print("marionette: no controller found ({}); the simulated controller plays the demo\n", choice.reason);
-            input = "sim:builtin:demo";
+            c.input = "sim:builtin:demo";
         } else {
             device.backend = "auto";
-            use_device = true;
+            c.use_device = true;
         }
-    } else if (input == "evdev" || input == "hidapi" || input == "sdl") {
-        device.backend = input == "hidapi" ? "hidraw" : input;
-        use_device = true;
+    } else if (c.input == "evdev" || c.input == "hidapi" || c.input == "sdl") {
+        device.backend = c.input == "hidapi" ? "hidraw" : c.input;
+        c.use_device = true;
         if (o.fast) throw_fast_needs_script();
         // Asked for by name: no pad is an error now, not a run that idles forever.
-        if (const std::string missing = missing_pad(device.backend, device.evdev_dir); !missing.empty())
-            throw ImportError("--input " + input, 0, missing);
+        if (const Outcome found = find_pad(device.backend, device.evdev_dir); !found.ok())
+            throw ImportError("--input " + c.input, 0, found.problem());
     }
-    if (use_device && o.fast) throw_fast_needs_script();
-    if (!o.unplug.empty() && input.rfind("sim:", 0) != 0)
+    if (c.use_device && o.fast) throw_fast_needs_script();
+    if (!o.unplug.empty() && c.input.rfind("sim:", 0) != 0)
         throw ImportError("--sim-unplug", 0, "only the simulated controller (--input sim:PROGRAM) can be unplugged");
+    return c;
+}
 
-    if (use_device) {
-        device.config = input::apply_input_config_text(input::InputConfig{}, embedded::find("config/input.toml"),
-                                                       "config/input.toml");
-        p.device = &device;
-        p.total_ticks = std::numeric_limits<std::uint64_t>::max();  // until stopped
-        source = "controller (" + device.backend + ")";
-    } else if (input.rfind("sim:", 0) == 0) {
-        const StickProgram program = load_program(input.substr(4));
-        std::vector<UnplugWindow> unplug;
-        for (size_t i = 0; i + 1 < o.unplug.size(); i += 2) unplug.push_back({o.unplug[i], o.unplug[i + 1]});
-        p.script = script_from_program(program, kSimulatedControllerHz, unplug);
-        p.total_ticks = static_cast<std::uint64_t>(std::llround(program.duration_s() * config.tick_rate_hz));
-        source = fmt::format("simulated controller playing '{}' ({:.1f} s) at {} Hz", program.name,
-                             program.duration_s(), kSimulatedControllerHz);
-    } else if (input.rfind("log:", 0) == 0) {
-        const std::string file = input.substr(4);
-        const DecodedInputLog log = decode_input_log(read_binary_file(file), file);
-        if (!log.warning.empty()) fmt::print(stderr, "warning: {}\n", log.warning);
-        // The recording's own configuration, so the live replay matches it; --config may retune on top.
-        config = config_from_text(log.header.config_text, file + " (embedded configuration)");
-        if (!o.config_file.empty()) {
-            const SimConfig tuned = apply_config_text(config, read_text_file(o.config_file), o.config_file);
-            if (const std::string key = structural_change(config, tuned); !key.empty())
-                throw ConfigError(o.config_file, 0, key, "differs from the log's and cannot change for a live replay");
-            config = tuned;
-        }
-        SimConfig running = config;
-        for (const InputLogConfigChange& change : log.config_changes) {
-            const SimConfig next =
-                apply_config_text(running, change.config_text, fmt::format("{} (config change before tick {})", file, change.before_tick));
-            if (const std::string key = structural_change(running, next); !key.empty())
-                throw ImportError(file, 0, "recorded configuration change alters " + key + ", which cannot change live");
-            p.scheduled_changes.push_back({change.before_tick, next});
-            running = next;
-        }
-        p.script = script_from_log(log, 1'000'000'000 / config.tick_rate_hz);
-        p.total_ticks = log.ticks.size();
-        source = fmt::format("input log {} ({} ticks)", file, log.ticks.size());
-    } else {
-        throw ImportError("--input " + input, 0, "expected auto, evdev, hidapi, sdl, sim:PROGRAM or log:FILE");
+// `--input sim:PROGRAM`: the program played by a simulated controller, unplugged
+// where --sim-unplug says. Returns the description for the banner.
+std::string prepare_program_input(const RunOptions& o, const std::string& program_name, const SimConfig& config,
+                                  PipelineOptions& p) {
+    const StickProgram program = load_program(program_name);
+    std::vector<UnplugWindow> unplug;
+    for (size_t i = 0; i + 1 < o.unplug.size(); i += 2) unplug.push_back({o.unplug[i], o.unplug[i + 1]});
+    p.script = script_from_program(program, kSimulatedControllerHz, unplug);
+    p.total_ticks = static_cast<std::uint64_t>(std::llround(program.duration_s() * config.tick_rate_hz));
+    return fmt::format("simulated controller playing '{}' ({:.1f} s) at {} Hz", program.name, program.duration_s(),
+                       kSimulatedControllerHz);
+}
+
+// `--input log:FILE`: the recording's own configuration, so the live replay
+// matches it (--config may retune on top, nothing structural), and its recorded
+// changes scheduled before their ticks. Returns the description for the banner.
+std::string prepare_log_input(const RunOptions& o, const std::string& file, AppConfig& config, PipelineOptions& p) {
+    const DecodedInputLog log = decode_input_log(read_binary_file(file), file);
+    if (!log.warning.empty()) fmt::print(stderr, "warning: {}\n", log.warning);
+    config = config_from_text(log.header.config_text, file + " (embedded configuration)");
+    if (!o.config_file.empty()) {
+        const AppConfig tuned = apply_config_text(config, read_text_file(o.config_file), o.config_file);
+        if (const Outcome kept = structure_unchanged(config.sim, tuned.sim); !kept.ok())
+            throw ConfigError(o.config_file, 0, kept.problem(), "differs from the log's and cannot change for a live replay");
+        config = tuned;
     }
-    const std::uint64_t headless_ticks = p.total_ticks;
-    // The display: a window or KMS draws with render_es; headless (also what auto
-    // picks with no display) runs the interpolating frame loop without a GPU.
-    const render::PlatformRequest request = o.display == "window" ? render::PlatformRequest::window
-                                            : o.display == "kms"  ? render::PlatformRequest::kms
-                                            : o.display == "headless" ? render::PlatformRequest::headless
-                                                                      : render::PlatformRequest::automatic;
+    SimConfig running = config.sim;
+    for (const InputLogConfigChange& change : log.config_changes) {
+        const SimConfig next = apply_config_change(running, change.config_text,
+                                                   fmt::format("{} (config change before tick {})", file, change.before_tick));
+        if (const Outcome kept = structure_unchanged(running, next); !kept.ok())
+            throw ImportError(file, 0, "recorded configuration change alters " + kept.problem() + ", which cannot change live");
+        p.scheduled_changes.push_back({change.before_tick, next});
+        running = next;
+    }
+    p.script = script_from_log(log, 1'000'000'000 / config.sim.tick_rate_hz);
+    p.total_ticks = log.ticks.size();
+    return fmt::format("input log {} ({} ticks)", file, log.ticks.size());
+}
+
+// The display: a window or KMS draws with render_es (the run then lasts until
+// the window is closed); headless (also what auto picks with no display) runs
+// the interpolating frame loop without a GPU.
+render::PlatformKind prepare_display(render::PlatformRequest request, PipelineOptions& p) {
     const render::PlatformKind kind = render::select_platform(request, render::detect_display_environment());
-    if (kind != render::PlatformKind::headless) {
-        const RenderConfig rc = load_render_config("");
-        p.display.gl = true;
-        p.display.settings = rc.settings;
-        p.display.platform.kind = kind;
-        p.display.platform.width = rc.settings.width;
-        p.display.platform.height = rc.settings.height;
-        p.display.platform.msaa_samples = rc.settings.msaa_samples;
-        p.display.platform.vsync = rc.settings.vsync;
-        p.display.platform.fullscreen = rc.settings.fullscreen;
-        p.display.platform.drm_device = rc.drm_device;
-        p.display.platform.kms_mode = rc.kms;
-        // With a display the run lasts until the window is closed (or --duration).
-        p.total_ticks = std::numeric_limits<std::uint64_t>::max();
-    }
-    if (o.duration_s >= 0.0) p.total_ticks = static_cast<std::uint64_t>(o.duration_s * config.tick_rate_hz + 0.5);
+    if (kind == render::PlatformKind::headless) return kind;
+    const RenderConfig rc = load_render_config("");
+    p.display.gl = true;
+    p.display.settings = rc.settings;
+    p.display.platform.kind = kind;
+    p.display.platform.width = rc.settings.width;
+    p.display.platform.height = rc.settings.height;
+    p.display.platform.msaa_samples = rc.settings.msaa_samples;
+    p.display.platform.vsync = rc.settings.vsync;
+    p.display.platform.fullscreen = rc.settings.fullscreen;
+    p.display.platform.drm_device = rc.drm_device;
+    p.display.platform.kms_mode = rc.kms;
+    p.total_ticks = std::numeric_limits<std::uint64_t>::max();
+    return kind;
+}
 
-    p.config = config;
-    p.graph = load_graph_argument_rebuilding_stale(o.graph_file, config);
-    p.virtual_time = o.fast;
-    p.record_file = o.record_file;
-    p.trace_file = o.trace_file;
-    p.watch_config_file = o.config_file;  // live tuning of the file given
-    p.stop_request = &g_stop_requested;
-    p.stop_request_time_ns = &g_stop_requested_ns;
+render::PlatformRequest display_request(const std::string& display) {
+    if (display == "window") return render::PlatformRequest::window;
+    if (display == "kms") return render::PlatformRequest::kms;
+    if (display == "headless") return render::PlatformRequest::headless;
+    return render::PlatformRequest::automatic;
+}
 
+void print_run_banner(const RunOptions& o, const PipelineOptions& p, render::PlatformKind kind, const std::string& source) {
+    const int rate = p.config.tick_rate_hz;
     if (p.total_ticks == std::numeric_limits<std::uint64_t>::max())
-        fmt::print("marionette: {} run, {} at {} Hz until {}{}\n", render::platform_name(kind), source,
-                   config.tick_rate_hz, p.display.gl ? "the window is closed" : "stopped (Ctrl-C)",
-                   o.fast ? " (no real-time pacing)" : "");
+        fmt::print("marionette: {} run, {} at {} Hz until {}{}\n", render::platform_name(kind), source, rate,
+                   p.display.gl ? "the window is closed" : "stopped (Ctrl-C)", o.fast ? " (no real-time pacing)" : "");
     else
-        fmt::print("marionette: {} run, {} at {} Hz for {:.1f} s{}\n", render::platform_name(kind), source,
-                   config.tick_rate_hz, static_cast<double>(p.total_ticks) / config.tick_rate_hz,
-                   o.fast ? " (no real-time pacing)" : "");
+        fmt::print("marionette: {} run, {} at {} Hz for {:.1f} s{}\n", render::platform_name(kind), source, rate,
+                   static_cast<double>(p.total_ticks) / rate, o.fast ? " (no real-time pacing)" : "");
     if (!o.config_file.empty()) fmt::print("marionette: watching {} for live tuning\n", o.config_file);
     std::fflush(stdout);
+}
 
+// Runs the pipeline with SIGINT/SIGTERM turned into a clean stop. When auto
+// found a display it could not open, says so and runs headless instead.
+PipelineResult run_stoppable(const RunOptions& o, PipelineOptions& p, render::PlatformRequest request,
+                             std::uint64_t headless_ticks) {
     g_stop_requested.store(false);
     g_stop_requested_ns.store(0);
     std::signal(SIGINT, on_stop_signal);
@@ -220,7 +217,6 @@ int run_command(const RunOptions& o) {
         r = run_pipeline(p);
     } catch (const render::PlatformError& e) {
         if (request != render::PlatformRequest::automatic) throw;
-        // auto found a display it could not open: say so and run headless.
         fmt::print(stderr, "warning: {}; running headless\n", e.what());
         p.display.gl = false;
         if (o.duration_s < 0.0) p.total_ticks = headless_ticks;
@@ -230,7 +226,11 @@ int run_command(const RunOptions& o) {
     if (!r.input_description.empty()) fmt::print("input: {}\n", r.input_description);
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
+    return r;
+}
 
+// The closing summary; 1 when the writer fell behind and outputs are incomplete.
+int report_run(const RunOptions& o, const SimConfig& config, const PipelineResult& r) {
     if (!o.stats_json.empty()) write_stats_json(o.stats_json, o, config, r);
     fmt::print("{}: {:.1f} s, {} ticks; walked {:.1f} m, top speed {:.2f} m/s; {} catch-up drops; "
                "input→tick latency p50 {:.2f} ms p99 {:.2f} ms max {:.2f} ms; {} samples dropped; {} frames ({} missed); "
@@ -247,6 +247,47 @@ int run_command(const RunOptions& o) {
         return 1;
     }
     return 0;
+}
+
+}  // namespace
+
+int run_command(const RunOptions& o) {
+    AppConfig config = load_config(o.config_file);
+    PipelineOptions p;
+    input::InputThreadOptions device;
+    const InputChoice input = choose_input(o, device);
+    std::string source;
+    if (input.use_device) {
+        device.config = input::apply_input_config_text(input::InputConfig{}, embedded::find("config/input.toml"),
+                                                       "config/input.toml");
+        p.device = &device;
+        p.total_ticks = std::numeric_limits<std::uint64_t>::max();  // until stopped
+        source = "controller (" + device.backend + ")";
+    } else if (input.input.rfind("sim:", 0) == 0) {
+        source = prepare_program_input(o, input.input.substr(4), config.sim, p);
+    } else if (input.input.rfind("log:", 0) == 0) {
+        source = prepare_log_input(o, input.input.substr(4), config, p);
+    } else {
+        throw ImportError("--input " + input.input, 0, "expected auto, evdev, hidapi, sdl, sim:PROGRAM or log:FILE");
+    }
+    const std::uint64_t headless_ticks = p.total_ticks;
+    const render::PlatformRequest request = display_request(o.display);
+    const render::PlatformKind kind = prepare_display(request, p);
+    if (o.duration_s >= 0.0) p.total_ticks = static_cast<std::uint64_t>(o.duration_s * config.sim.tick_rate_hz + 0.5);
+
+    p.config = config.sim;
+    p.realtime = config.realtime;
+    p.graph = load_graph_argument_rebuilding_stale(o.graph_file, config.sim, config.graph_build);
+    p.virtual_time = o.fast;
+    p.record_file = o.record_file;
+    p.trace_file = o.trace_file;
+    p.watch_config_file = o.config_file;  // live tuning of the file given
+    p.stop_request = &g_stop_requested;
+    p.stop_request_time_ns = &g_stop_requested_ns;
+
+    print_run_banner(o, p, kind, source);
+    const PipelineResult r = run_stoppable(o, p, request, headless_ticks);
+    return report_run(o, config.sim, r);
 }
 
 void register_run_command(CLI::App& app, int& exit_code) {

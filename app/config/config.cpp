@@ -7,6 +7,7 @@
 #include <fstream>
 #include <optional>
 #include <sstream>
+#include <type_traits>
 #include <variant>
 
 #include "app/config/embedded.hpp"
@@ -16,13 +17,43 @@ namespace marionette {
 
 namespace {
 
-using IntField = std::int32_t SimConfig::*;
-using FloatField = float SimConfig::*;
+// A key's field: a member of one of AppConfig's parts. Only SimConfig's are
+// written into logs (serialize_config); the others are read from files only.
+using Field = std::variant<std::int32_t SimConfig::*, float SimConfig::*, std::int32_t RealtimeConfig::*,
+                           std::int32_t GraphBuildConfig::*, float GraphBuildConfig::*>;
+
+template <typename Member>
+struct MemberOf;
+template <typename Part, typename Value>
+struct MemberOf<Value Part::*> {
+    using part = Part;
+    using value = Value;
+};
+
+SimConfig& part_of(AppConfig& c, const SimConfig*) { return c.sim; }
+RealtimeConfig& part_of(AppConfig& c, const RealtimeConfig*) { return c.realtime; }
+GraphBuildConfig& part_of(AppConfig& c, const GraphBuildConfig*) { return c.graph_build; }
+
+// Calls visit(value) with a reference to the field's value in `config`.
+template <typename Visit>
+void visit_field(AppConfig& config, const Field& field, Visit&& visit) {
+    std::visit(
+        [&](auto member) {
+            using Part = typename MemberOf<decltype(member)>::part;
+            visit(part_of(config, static_cast<const Part*>(nullptr)).*member);
+        },
+        field);
+}
+
+bool is_integer(const Field& field) {
+    return std::visit([](auto member) { return std::is_same_v<typename MemberOf<decltype(member)>::value, std::int32_t>; },
+                      field);
+}
 
 struct KeySpec {
     const char* table;
     const char* key;
-    std::variant<IntField, FloatField> field;
+    Field field;
     double min;
     double max;
     const char* doc;
@@ -53,23 +84,24 @@ const KeySpec kKeys[] = {
     {"locomotion", "turn_rate_deg_s", &SimConfig::turn_rate_deg_s, 1.0, 3600.0, "how fast the heading follows the direction of travel (°/s)"},
     {"locomotion", "stick_deadzone", &SimConfig::stick_deadzone, 0.0, 0.9, "radial deadzone, fraction of full deflection"},
     {"locomotion", "response_curve", &SimConfig::response_curve, 0.0, 1.0, "0 linear … 1 quadratic response of speed to deflection"},
-    // [realtime]: `marionette run` thread settings, applied at start only.
-    {"realtime", "input_priority", &SimConfig::input_priority, 0, 99, "SCHED_FIFO priority of the input thread (0: normal scheduling)"},
-    {"realtime", "simulation_priority", &SimConfig::simulation_priority, 0, 99, "SCHED_FIFO priority of the simulation thread (0: normal scheduling)"},
-    {"realtime", "render_priority", &SimConfig::render_priority, 0, 99, "SCHED_FIFO priority of the render thread (0: normal scheduling)"},
-    {"realtime", "input_cpu", &SimConfig::input_cpu, -1, 1023, "CPU the input thread is pinned to (-1: any)"},
-    {"realtime", "simulation_cpu", &SimConfig::simulation_cpu, -1, 1023, "CPU the simulation thread is pinned to (-1: any)"},
-    {"realtime", "render_cpu", &SimConfig::render_cpu, -1, 1023, "CPU the render thread is pinned to (-1: any)"},
-    {"realtime", "lock_memory", &SimConfig::lock_memory, 0, 1, "1: lock all memory (mlockall) before the threads start"},
-    // motion graph (docs/motion-graph.md)
-    {"motion_graph", "analysis_rate_hz", &SimConfig::graph_analysis_rate_hz, 5, 240, "rate clips are resampled to for the graph build"},
-    {"motion_graph", "window_frames", &SimConfig::graph_window_frames, 2, 120, "k: frames in the distance window and in each transition"},
-    {"motion_graph", "neighbourhood_frames", &SimConfig::graph_neighbourhood_frames, 1, 60, "local minima are taken over (2h+1)² frame pairs"},
-    {"motion_graph", "threshold_percentile", &SimConfig::graph_threshold_percentile, 0.01, 100.0, "transition threshold as a percentile of all pair distances"},
-    {"motion_graph", "threshold_absolute", &SimConfig::graph_threshold_absolute, 0.0, 100.0, "when > 0, the threshold itself (mean squared distance in leg lengths²)"},
-    {"motion_graph", "bridge_percentile", &SimConfig::graph_bridge_percentile, 0.01, 100.0, "clips cut off from the component get their cheapest transitions below this percentile"},
-    {"motion_graph", "contact_height", &SimConfig::graph_contact_height, 0.0, 1.0, "foot contact: height above the clip's ground, leg lengths"},
-    {"motion_graph", "contact_speed", &SimConfig::graph_contact_speed, 0.0, 10.0, "foot contact: ground-plane speed, leg lengths per second"},
+    // [realtime]: `marionette run` thread settings, applied at start only (RealtimeConfig: not in logs).
+    {"realtime", "input_priority", &RealtimeConfig::input_priority, 0, 99, "SCHED_FIFO priority of the input thread (0: normal scheduling)"},
+    {"realtime", "simulation_priority", &RealtimeConfig::simulation_priority, 0, 99, "SCHED_FIFO priority of the simulation thread (0: normal scheduling)"},
+    {"realtime", "render_priority", &RealtimeConfig::render_priority, 0, 99, "SCHED_FIFO priority of the render thread (0: normal scheduling)"},
+    {"realtime", "input_cpu", &RealtimeConfig::input_cpu, -1, 1023, "CPU the input thread is pinned to (-1: any)"},
+    {"realtime", "simulation_cpu", &RealtimeConfig::simulation_cpu, -1, 1023, "CPU the simulation thread is pinned to (-1: any)"},
+    {"realtime", "render_cpu", &RealtimeConfig::render_cpu, -1, 1023, "CPU the render thread is pinned to (-1: any)"},
+    {"realtime", "lock_memory", &RealtimeConfig::lock_memory, 0, 1, "1: lock all memory (mlockall) before the threads start"},
+    // [motion_graph] (docs/motion-graph.md): the build parameters (GraphBuildConfig: not in logs), then the
+    // controller's keys, which the tick reads.
+    {"motion_graph", "analysis_rate_hz", &GraphBuildConfig::graph_analysis_rate_hz, 5, 240, "rate clips are resampled to for the graph build"},
+    {"motion_graph", "window_frames", &GraphBuildConfig::graph_window_frames, 2, 120, "k: frames in the distance window and in each transition"},
+    {"motion_graph", "neighbourhood_frames", &GraphBuildConfig::graph_neighbourhood_frames, 1, 60, "local minima are taken over (2h+1)² frame pairs"},
+    {"motion_graph", "threshold_percentile", &GraphBuildConfig::graph_threshold_percentile, 0.01, 100.0, "transition threshold as a percentile of all pair distances"},
+    {"motion_graph", "threshold_absolute", &GraphBuildConfig::graph_threshold_absolute, 0.0, 100.0, "when > 0, the threshold itself (mean squared distance in leg lengths²)"},
+    {"motion_graph", "bridge_percentile", &GraphBuildConfig::graph_bridge_percentile, 0.01, 100.0, "clips cut off from the component get their cheapest transitions below this percentile"},
+    {"motion_graph", "contact_height", &GraphBuildConfig::graph_contact_height, 0.0, 1.0, "foot contact: height above the clip's ground, leg lengths"},
+    {"motion_graph", "contact_speed", &GraphBuildConfig::graph_contact_speed, 0.0, 10.0, "foot contact: ground-plane speed, leg lengths per second"},
     {"motion_graph", "transition_weight", &SimConfig::graph_transition_weight, 0.0, 1000.0, "path cost: seconds charged per unit of transition distance"},
     {"motion_graph", "horizon_s", &SimConfig::graph_horizon_s, 0.1, 10.0, "controller: look-ahead of the stick-following search (s)"},
     {"motion_graph", "max_nodes_per_tick", &SimConfig::graph_max_nodes_per_tick, 1, 100000, "controller: search nodes expanded per tick at most"},
@@ -135,6 +167,43 @@ std::string format_number(Number v) {
     std::string s(buf, end);
     if (s.find_first_of(".eE") == std::string::npos && s.find("inf") == std::string::npos) s += ".0";
     return s;
+}
+
+// A key's value from `node`, checked against the key's type and range.
+template <typename Value>
+Value read_key_value(const toml::node& node, const KeySpec& spec, const std::string& file, const std::string& full) {
+    const std::string range = "[" + format_number(spec.min) + ", " + format_number(spec.max) + "]";
+    if constexpr (std::is_same_v<Value, std::int32_t>) {
+        const auto* v = node.as_integer();
+        if (!v) throw ConfigError(file, line_of(node), full, "expected an integer in " + range);
+        const std::int64_t value = v->get();
+        if (value < spec.min || value > spec.max)
+            throw ConfigError(file, line_of(node), full,
+                              std::to_string(value) + " is out of range: expected an integer in " + range);
+        return static_cast<std::int32_t>(value);
+    } else {
+        double value = 0.0;
+        if (const auto* f = node.as_floating_point()) value = f->get();
+        else if (const auto* i = node.as_integer()) value = static_cast<double>(i->get());
+        else throw ConfigError(file, line_of(node), full, "expected a number in " + range);
+        if (!std::isfinite(value) || value < spec.min || value > spec.max)
+            throw ConfigError(file, line_of(node), full,
+                              format_number(value) + " is out of range: expected a number in " + range);
+        return static_cast<float>(value);
+    }
+}
+
+// The value of a SimConfig key as the effective text writes it (floats in the
+// shortest text that reads back to the same bits); nothing for other parts' keys.
+std::optional<std::string> sim_value_text(const SimConfig& config, const Field& field) {
+    return std::visit(
+        [&](auto member) -> std::optional<std::string> {
+            using Member = MemberOf<decltype(member)>;
+            if constexpr (!std::is_same_v<typename Member::part, SimConfig>) return std::nullopt;
+            else if constexpr (std::is_same_v<typename Member::value, std::int32_t>) return std::to_string(config.*member);
+            else return format_number(config.*member);
+        },
+        field);
 }
 
 // [terrain]: `name` (a built-in terrain or a file path) and/or inline data
@@ -269,14 +338,14 @@ std::string serialize_buttons(const SimConfig& config) {
 std::vector<ConfigKeyInfo> config_schema() {
     std::vector<ConfigKeyInfo> out;
     for (const KeySpec& k : kKeys)
-        out.push_back({k.table, k.key, std::holds_alternative<IntField>(k.field) ? "integer" : "float", k.min, k.max, k.doc});
+        out.push_back({k.table, k.key, is_integer(k.field) ? "integer" : "float", k.min, k.max, k.doc});
     out.push_back({"motion", "source", "string", 0, 0, "what poses the puppet: auto, gait, graph or graph_feet"});
     for (const std::string_view b : kButtonNames)
         out.push_back({"motion_graph.buttons", std::string(b), "string", 0.0, 0.0, "graph label played when the button is pressed, \"\" for none"});
     return out;
 }
 
-SimConfig apply_config_text(const SimConfig& base, std::string_view text, const std::string& file) {
+AppConfig apply_config_text(const AppConfig& base, std::string_view text, const std::string& file) {
     toml::table doc;
     try {
         doc = toml::parse(text, file);
@@ -284,7 +353,8 @@ SimConfig apply_config_text(const SimConfig& base, std::string_view text, const 
         throw ConfigError(file, static_cast<int>(e.source().begin.line), "",
                           "TOML syntax error: " + std::string(e.description()));
     }
-    SimConfig config = base;
+    AppConfig app = base;
+    SimConfig& config = app.sim;
     for (const auto& [table_key, table_node] : doc) {
         const std::string table_name(table_key.str());
         const std::string known = known_keys_of(table_name);
@@ -316,25 +386,9 @@ SimConfig apply_config_text(const SimConfig& base, std::string_view text, const 
                 if (table_name == k.table && key.str() == k.key) spec = &k;
             if (!spec)
                 throw ConfigError(file, line_of(node), full, "unknown key (expected one of: " + known + ")");
-            const std::string range = "[" + format_number(spec->min) + ", " + format_number(spec->max) + "]";
-            if (std::holds_alternative<IntField>(spec->field)) {
-                const auto* v = node.as_integer();
-                if (!v) throw ConfigError(file, line_of(node), full, "expected an integer in " + range);
-                const std::int64_t value = v->get();
-                if (value < spec->min || value > spec->max)
-                    throw ConfigError(file, line_of(node), full,
-                                      std::to_string(value) + " is out of range: expected an integer in " + range);
-                config.*std::get<IntField>(spec->field) = static_cast<std::int32_t>(value);
-            } else {
-                double value = 0.0;
-                if (const auto* f = node.as_floating_point()) value = f->get();
-                else if (const auto* i = node.as_integer()) value = static_cast<double>(i->get());
-                else throw ConfigError(file, line_of(node), full, "expected a number in " + range);
-                if (!std::isfinite(value) || value < spec->min || value > spec->max)
-                    throw ConfigError(file, line_of(node), full,
-                                      format_number(value) + " is out of range: expected a number in " + range);
-                config.*std::get<FloatField>(spec->field) = static_cast<float>(value);
-            }
+            visit_field(app, spec->field, [&](auto& value) {
+                value = read_key_value<std::remove_reference_t<decltype(value)>>(node, *spec, file, full);
+            });
         }
     }
     // Relations between keys.
@@ -347,7 +401,7 @@ SimConfig apply_config_text(const SimConfig& base, std::string_view text, const 
         throw ConfigError(file, doc["puppet"]["pelvis_height"].node() ? line_of(*doc["puppet"]["pelvis_height"].node()) : 0,
                           "puppet.pelvis_height",
                           "must not exceed thigh_length + shin_length + ankle_height, or the feet cannot reach the ground");
-    return config;
+    return app;
 }
 
 namespace {
@@ -370,10 +424,10 @@ std::string motion_source_name(MotionSourceSetting source) {
 
 std::string_view default_config_text() { return embedded::find("config/marionette.toml"); }
 
-SimConfig default_config() { return apply_config_text(SimConfig{}, default_config_text(), "config/marionette.toml"); }
+AppConfig default_config() { return apply_config_text(AppConfig{}, default_config_text(), "config/marionette.toml"); }
 
-SimConfig load_config(const std::string& user_file) {
-    SimConfig config = default_config();
+AppConfig load_config(const std::string& user_file) {
+    AppConfig config = default_config();
     if (!user_file.empty()) config = apply_config_text(config, read_file(user_file), user_file);
     return config;
 }
@@ -382,18 +436,14 @@ std::string serialize_config(const SimConfig& config) {
     std::string out = "# marionette effective configuration\n";
     std::string table;
     for (const KeySpec& k : kKeys) {
+        const std::optional<std::string> value = sim_value_text(config, k.field);
+        if (!value) continue;  // [realtime] and the graph build keys: the tick never reads them
         if (table != k.table) {
             table = k.table;
             out += "\n[" + table + "]\n";
             if (table == "motion") out += "source = " + toml_string(motion_source_name(config.motion_source)) + "\n";
         }
-        out += std::string(k.key) + " = ";
-        if (std::holds_alternative<IntField>(k.field))
-            out += std::to_string(config.*std::get<IntField>(k.field));
-        else
-            // Shortest text that reads back to the same float (to_chars round-trips).
-            out += format_number(config.*std::get<FloatField>(k.field));
-        out += "\n";
+        out += std::string(k.key) + " = " + *value + "\n";
     }
     out += serialize_prototypes(config.walk, "gait.walk");
     out += serialize_prototypes(config.run, "gait.run");
@@ -421,8 +471,14 @@ std::string serialize_prototypes(const GaitPrototypes& p, const std::string& tab
 }
 }  // namespace
 
-SimConfig config_from_text(std::string_view text, const std::string& origin) {
+AppConfig config_from_text(std::string_view text, const std::string& origin) {
     return apply_config_text(default_config(), text, origin);
+}
+
+SimConfig apply_config_change(const SimConfig& running, std::string_view text, const std::string& origin) {
+    AppConfig app = default_config();
+    app.sim = running;
+    return apply_config_text(app, text, origin).sim;
 }
 
 }  // namespace marionette

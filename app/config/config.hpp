@@ -3,28 +3,25 @@
 // (config/marionette.toml, also compiled into the binary) states every key; a user
 // file overrides only what it names. Errors name file, line, key and what was
 // expected.
-#include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
-#include "runtime/sim/sim_config.hpp"
+#include "app/config/app_config.hpp"
+#include "runtime/errors/parse_error.hpp"
 
 namespace marionette {
 
-class ConfigError : public std::runtime_error {
+// A configuration file's error: a ParseError whose subject is the key at fault
+// ("table.key"; empty for the file as a whole).
+class ConfigError : public ParseError {
 public:
     ConfigError(std::string file, int line, std::string key, std::string message)
-        : std::runtime_error(file + (line > 0 ? ":" + std::to_string(line) : std::string()) +
-                             (key.empty() ? std::string() : ": " + key) + ": " + message),
-          file_(std::move(file)), line_(line), key_(std::move(key)) {}
-    const std::string& file() const { return file_; }
-    int line() const { return line_; }
+        : ParseError(std::move(file), line, -1, key, std::move(message)), key_(std::move(key)) {}
     const std::string& key() const { return key_; }
 
 private:
-    std::string file_;
-    int line_;
     std::string key_;
 };
 
@@ -44,22 +41,30 @@ std::vector<ConfigKeyInfo> config_schema();
 std::string motion_source_name(MotionSourceSetting source);
 
 // Applies the TOML text on top of `base`. Throws ConfigError.
-SimConfig apply_config_text(const SimConfig& base, std::string_view toml_text, const std::string& file_name);
+AppConfig apply_config_text(const AppConfig& base, std::string_view toml_text, const std::string& file_name);
 
 // The built-in default file's text and the configuration it gives.
 std::string_view default_config_text();
-SimConfig default_config();
+AppConfig default_config();
 
 // Defaults, then the user file (if the path is not empty). Throws ConfigError
 // (a missing or unreadable file is one too).
-SimConfig load_config(const std::string& user_file);
+AppConfig load_config(const std::string& user_file);
 
-// The complete effective configuration as TOML, keys in schema order, floats
-// printed so they parse back to the same bits. Logs embed this text.
+// The effective simulation configuration as TOML, keys in schema order, floats
+// printed so they parse back to the same bits: every key the tick reads and no
+// other ([realtime] and the graph build keys are not in it). Logs embed this text.
 std::string serialize_config(const SimConfig& config);
 
-// Parses text written by serialize_config (or any complete or partial config) on
-// top of the defaults, as replay does with a log's embedded configuration.
-SimConfig config_from_text(std::string_view toml_text, const std::string& origin);
+// A log's embedded configuration (text written by serialize_config, or any
+// complete or partial config) on top of the defaults, as replay reads it. Logs
+// written before the tick's keys were split from the rest also carry [realtime]
+// and the [motion_graph] build keys: still accepted, they land in the parts the
+// tick never reads (a `--graph default` replay builds the default graph with them).
+AppConfig config_from_text(std::string_view toml_text, const std::string& origin);
+
+// A log's configuration change (or any TOML text) applied on top of the running
+// simulation configuration; keys of the other parts are accepted and dropped.
+SimConfig apply_config_change(const SimConfig& running, std::string_view toml_text, const std::string& origin);
 
 }  // namespace marionette

@@ -8,6 +8,7 @@
 
 #include "app/config/embedded.hpp"
 #include "app/io/files.hpp"
+#include "runtime/errors/outcome.hpp"
 
 namespace marionette {
 
@@ -22,22 +23,22 @@ struct RenderKey {
     double max;
     const char* doc;
     // Stores the validated value; `text` carries strings, `number` numbers and
-    // booleans (0/1), `colour` colours. Returns an error message or "".
-    std::function<std::string(RenderConfig&, double number, const vec3& colour, const std::string& text)> set;
+    // booleans (0/1), `colour` colours. Fails saying what was expected.
+    std::function<Outcome(RenderConfig&, double number, const vec3& colour, const std::string& text)> set;
 };
 
 using S = render::RenderSettings;
 auto int_field(std::int32_t S::*f) {
-    return [f](RenderConfig& c, double v, const vec3&, const std::string&) { c.settings.*f = static_cast<std::int32_t>(v); return std::string(); };
+    return [f](RenderConfig& c, double v, const vec3&, const std::string&) { c.settings.*f = static_cast<std::int32_t>(v); return Outcome::success(); };
 }
 auto bool_field(bool S::*f) {
-    return [f](RenderConfig& c, double v, const vec3&, const std::string&) { c.settings.*f = v != 0.0; return std::string(); };
+    return [f](RenderConfig& c, double v, const vec3&, const std::string&) { c.settings.*f = v != 0.0; return Outcome::success(); };
 }
 auto colour_field(vec3 S::*f) {
-    return [f](RenderConfig& c, double, const vec3& v, const std::string&) { c.settings.*f = v; return std::string(); };
+    return [f](RenderConfig& c, double, const vec3& v, const std::string&) { c.settings.*f = v; return Outcome::success(); };
 }
 auto camera_field(float render::CameraSettings::*f) {
-    return [f](RenderConfig& c, double v, const vec3&, const std::string&) { c.settings.camera.*f = static_cast<float>(v); return std::string(); };
+    return [f](RenderConfig& c, double v, const vec3&, const std::string&) { c.settings.camera.*f = static_cast<float>(v); return Outcome::success(); };
 }
 
 const std::vector<RenderKey>& keys() {
@@ -68,21 +69,21 @@ const std::vector<RenderKey>& keys() {
         {"overlays", "motion_graph", Kind::boolean, 0, 1, "motion-graph state line shown at start (key 4)", bool_field(&S::show_motion_graph)},
         {"overlays", "hud", Kind::boolean, 0, 1, "text HUD shown at start (key H)", bool_field(&S::show_hud)},
         {"kms", "device", Kind::text, 0, 0, "DRM device node; empty picks the first with a connected display",
-         [](RenderConfig& c, double, const vec3&, const std::string& t) { c.drm_device = t; return std::string(); }},
+         [](RenderConfig& c, double, const vec3&, const std::string& t) { c.drm_device = t; return Outcome::success(); }},
         {"kms", "connector", Kind::text, 0, 0, "connector name such as HDMI-A-1; empty picks the first connected",
-         [](RenderConfig& c, double, const vec3&, const std::string& t) { c.kms.connector = t; return std::string(); }},
+         [](RenderConfig& c, double, const vec3&, const std::string& t) { c.kms.connector = t; return Outcome::success(); }},
         {"kms", "mode", Kind::text, 0, 0, "forced mode WIDTHxHEIGHT or WIDTHxHEIGHT@HZ; empty chooses by policy",
          [](RenderConfig& c, double, const vec3&, const std::string& t) {
              c.kms.width = c.kms.height = c.kms.refresh_hz = 0;
-             if (t.empty() || parse_mode_text(t, c.kms)) return std::string();
-             return std::string("expected WIDTHxHEIGHT or WIDTHxHEIGHT@HZ (e.g. 1920x1080@60), got \"") + t + "\"";
+             if (t.empty() || parse_mode_text(t, c.kms)) return Outcome::success();
+             return Outcome::failure(std::string("expected WIDTHxHEIGHT or WIDTHxHEIGHT@HZ (e.g. 1920x1080@60), got \"") + t + "\"");
          }},
         {"kms", "policy", Kind::text, 0, 0, "mode choice without a forced mode: preferred or highest_refresh",
          [](RenderConfig& c, double, const vec3&, const std::string& t) {
              if (t == "preferred") c.kms.policy = render::KmsModePolicy::preferred;
              else if (t == "highest_refresh") c.kms.policy = render::KmsModePolicy::highest_refresh;
-             else return std::string("expected \"preferred\" or \"highest_refresh\", got \"") + t + "\"";
-             return std::string();
+             else return Outcome::failure(std::string("expected \"preferred\" or \"highest_refresh\", got \"") + t + "\"");
+             return Outcome::success();
          }},
     };
     return k;
@@ -205,8 +206,8 @@ RenderConfig apply_render_config_text(const RenderConfig& base, std::string_view
                     break;
                 }
             }
-            if (std::string error = spec->set(config, number, colour, string_value); !error.empty())
-                throw ConfigError(file, line_of(node), full, error);
+            if (const Outcome stored = spec->set(config, number, colour, string_value); !stored.ok())
+                throw ConfigError(file, line_of(node), full, stored.problem());
         }
     }
     return config;

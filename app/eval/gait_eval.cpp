@@ -139,17 +139,17 @@ bool foot_in_stance(const PuppetState& s, int foot) {
     return s.gait.feet[static_cast<std::size_t>(foot)].swinging == 0;
 }
 
-std::string gait_metric_non_finite(const GaitMetrics& m) {
+Outcome check_gait_metrics_finite(const GaitMetrics& m) {
     const std::pair<const char*, double> values[] = {{"foot_skate_mm", m.foot_skate_mm},
                                                      {"penetration_mm", m.penetration_mm},
                                                      {"speed_error_pct", m.speed_error_pct},
                                                      {"max_joint_speed_deg_s", m.max_joint_speed_deg_s}};
     for (const auto& [name, value] : values)
-        if (!std::isfinite(value)) return fmt::format("{} is not a finite number ({})", name, value);
-    return {};
+        if (!std::isfinite(value)) return Outcome::failure(fmt::format("{} is not a finite number ({})", name, value));
+    return Outcome::success();
 }
 
-std::string gait_limit_failures(const GaitMetrics& m) {
+Outcome check_gait_limits(const GaitMetrics& m) {
     std::string out;
     auto check = [&](const char* name, double value, double limit) {
         if (!(value < limit)) out += fmt::format("{}{} = {:.3f} (limit < {})", out.empty() ? "" : "; ", name, value, limit);
@@ -158,156 +158,226 @@ std::string gait_limit_failures(const GaitMetrics& m) {
     check("penetration_mm", m.penetration_mm, kMaxPenetrationMm);
     check("speed_error_pct", m.speed_error_pct, kMaxSpeedErrorPct);
     check("max_joint_speed_deg_s", m.max_joint_speed_deg_s, kMaxJointSpeedDegS);
-    return out;
+    return out.empty() ? Outcome::success() : Outcome::failure(out);
 }
+
+namespace {
+
+// Which joints the metrics read and the speed a full stick asks for: the gait's
+// puppet, or the motion graph that drives it.
+struct MeasuredPuppet {
+    FootGeometry feet[2] = {puppet_foot(kFootL), puppet_foot(kFootR)};
+    std::size_t pelvis_joint = static_cast<std::size_t>(kPelvis);
+    bool graph = false;
+    // With a graph: the controller asks for stick deflection × full_stick_speed
+    // leg lengths per second (no deadzone, curve or slope factor), and a leg is
+    // scaled to leg_metres (attach_motion_graph; a graph of the puppet's own
+    // skeleton is not scaled).
+    double graph_full_speed_m_s = 0.0;
+};
+
+MeasuredPuppet drive_with_graph(Simulation& sim, std::shared_ptr<const MotionGraph> graph, const SimConfig& config,
+                                GaitMetrics& m) {
+    MeasuredPuppet p;
+    if (graph->left_foot < 0 || graph->right_foot < 0)
+        throw std::runtime_error("the motion graph names no left and right foot joints, so the foot metrics cannot be measured");
+    const MotionGraph& g = *graph;
+    attach_motion_graph(sim, graph);
+    p.feet[0] = graph_foot(g, g.left_foot, sim.metres_per_unit());
+    p.feet[1] = graph_foot(g, g.right_foot, sim.metres_per_unit());
+    p.pelvis_joint = 0;
+    p.graph = true;
+    p.graph_full_speed_m_s = static_cast<double>(config.graph_full_stick_speed) *
+                             (g.leg_length > 0.0f ? g.leg_length : 1.0) * sim.metres_per_unit();
+    const std::int32_t source = sim.state().motion_source;
+    m.motion_source = source == kSourceGraphFeet ? "graph_feet" : source == kSourceGraph ? "graph" : "gait";
+    m.speed_expectation = "graph full_stick_speed x leg_metres x stick deflection";
+    return p;
+}
+
+// The metrics over one run, read from the simulation after every tick.
+class GaitMeter {
+public:
+    GaitMeter(const SimConfig& config, const Simulation& sim, const MeasuredPuppet& puppet,
+              const std::vector<TickInput>& ticks, std::vector<Hold> holds, bool feet_csv, GaitMetrics& m)
+        : config_(config), sim_(sim), terrain_(sim.terrain()), puppet_(puppet), ticks_(ticks), holds_(std::move(holds)),
+          m_(m), previous_(sim.state()), path_(holds_.size(), 0.0), expected_(holds_.size(), 0.0),
+          last_sample_(holds_.size()), sample_every_(static_cast<std::uint64_t>(config.tick_rate_hz / 4)) {
+        for (int i = 0; i < 2; ++i)
+            stance_anchor_[i] = sim.state().model_positions[static_cast<std::size_t>(puppet.feet[i].ankle)];
+        if (feet_csv)
+            csv_ = "tick,phase,speed,mode,pelvis_y,foot,swinging,progress,ankle_x,ankle_y,ankle_z,target_x,target_z,ankle_clear,sole_clear,ball_clear,tip_clear\n";
+    }
+
+    // After tick k (0-based) has run.
+    void measure_tick(std::uint64_t k) {
+        const PuppetState& s = sim_.state();
+        for (int i = 0; i < 2; ++i) measure_foot(i, s);
+        count_flight_phase();
+        measure_joint_speeds(s);
+        measure_hold_speeds(k, s);
+        previous_ = s;
+    }
+
+    // The worst speed error over the holds that ran to their end.
+    void finish_speed_error() {
+        for (std::size_t h = 0; h < holds_.size(); ++h) {
+            const double n = static_cast<double>(holds_[h].end_tick - holds_[h].first_tick);
+            if (holds_[h].end_tick > ticks_.size() || n < 2) continue;
+            const double seconds = (n - 1) / config_.tick_rate_hz;
+            const double actual = path_[h] / seconds;
+            const double want = expected_[h] / n;
+            if (want <= 0.0) continue;
+            m_.speed_error_pct = std::max(m_.speed_error_pct, std::fabs(actual - want) / want * 100.0);
+            ++m_.speed_windows;
+        }
+    }
+
+    const std::string& feet_csv() const { return csv_; }
+
+private:
+    // Penetration of the foot's points, touchdowns (steps) and skate in stance.
+    void measure_foot(int i, const PuppetState& s) {
+        const FootPoints fp = foot_points(s, puppet_.feet[i], config_);
+        double lowest = 1e9;
+        const bool stance = foot_in_stance(s, i);
+        for (int p_index = 0; p_index < fp.count; ++p_index) {
+            const vec3& p = fp.points[p_index];
+            const double clearance = static_cast<double>(p.y) - query_ground(terrain_, p.x, p.z).height;
+            if (-clearance * 1000.0 > m_.penetration_mm) {
+                m_.penetration_mm = -clearance * 1000.0;
+                m_.deepest_tick = s.tick;
+                m_.deepest_point = fmt::format("{} {} ({})", i == 0 ? "left" : "right", fp.names[p_index],
+                                               stance ? "stance" : "swing");
+            }
+            lowest = std::min(lowest, clearance);
+        }
+        if (!csv_.empty()) append_feet_csv_row(i, s, fp, stance);
+        if (!airborne_[i] && lowest > kAirborneM) airborne_[i] = true;
+        else if (airborne_[i] && lowest <= kGroundedM) {
+            airborne_[i] = false;
+            ++m_.steps;
+        }
+        // Skate: while the foot is in stance (foot_in_stance), its joint must not move.
+        const vec3 ankle = s.model_positions[static_cast<std::size_t>(puppet_.feet[i].ankle)];
+        if (stance && !was_stance_[i]) stance_anchor_[i] = ankle;
+        if (stance) {
+            const double dx = ankle.x - stance_anchor_[i].x, dz = ankle.z - stance_anchor_[i].z;
+            const double skate = std::sqrt(dx * dx + dz * dz) * 1000.0;
+            if (skate > m_.foot_skate_mm) {
+                m_.foot_skate_mm = skate;
+                m_.skate_tick = s.tick;
+            }
+        }
+        was_stance_[i] = stance;
+    }
+
+    void append_feet_csv_row(int i, const PuppetState& s, const FootPoints& fp, bool stance) {
+        const FootState& f = s.gait.feet[static_cast<std::size_t>(i)];
+        csv_ += fmt::format("{},{:.4f},{:.3f},{},{:.4f},{},{},{:.3f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f}", s.tick, s.gait.cycle_phase, s.gait.speed,
+                            static_cast<int>(s.gait.mode), s.gait.pelvis.y, i, stance ? 0 : 1, f.progress, fp.points[0].x,
+                            fp.points[0].y, fp.points[0].z, f.target.x, f.target.z);
+        for (int p_index = 0; p_index < 4; ++p_index) {
+            const vec3& p = fp.points[p_index];
+            if (p_index < fp.count) csv_ += fmt::format(",{:.4f}", p.y - query_ground(terrain_, p.x, p.z).height);
+            else csv_ += ",";
+        }
+        csv_ += "\n";
+    }
+
+    void count_flight_phase() {
+        if (!in_flight_ && airborne_[0] && airborne_[1]) {
+            in_flight_ = true;
+            ++m_.flight_phases;
+        } else if (in_flight_ && (!airborne_[0] || !airborne_[1])) {
+            in_flight_ = false;
+        }
+    }
+
+    void measure_joint_speeds(const PuppetState& s) {
+        const double dt_rate = config_.tick_rate_hz;
+        for (int j = 0; j < s.joint_count; ++j) {
+            const std::size_t i = static_cast<std::size_t>(j);
+            const double speed = quat_angle_between(previous_.local_rotations[i], s.local_rotations[i]) * dt_rate * det::kRadToDeg;
+            if (speed > m_.max_joint_speed_deg_s) {
+                m_.max_joint_speed_deg_s = speed;
+                m_.fastest_joint = sim_.skeleton().joint_names[i];
+                m_.fastest_joint_tick = s.tick;
+            }
+        }
+    }
+
+    // Speed over the holds: measured from the pelvis (with a graph, its root)
+    // joint; expected from the stick through the documented response curve and
+    // slope factor, or with a graph the controller's own target speed.
+    void measure_hold_speeds(std::uint64_t k, const PuppetState& s) {
+        const vec3 pelvis = s.model_positions[puppet_.pelvis_joint];
+        for (std::size_t h = 0; h < holds_.size(); ++h) {
+            const Hold& hold = holds_[h];
+            if (k < hold.first_tick || k >= hold.end_tick) continue;
+            if (puppet_.graph) {
+                const double sx = ticks_[k].left_x / static_cast<double>(kStickScale);
+                const double sy = ticks_[k].left_y / static_cast<double>(kStickScale);
+                expected_[h] += puppet_.graph_full_speed_m_s * std::sqrt(sx * sx + sy * sy);
+            } else {
+                const float deflection = std::min(1.0f, std::sqrt(hold.stick_x * hold.stick_x + hold.stick_y * hold.stick_y));
+                expected_[h] += config_.max_speed * stick_speed_fraction(deflection, config_) *
+                                slope_speed_multiplier(terrain_, config_, pelvis.x, pelvis.z, s.heading);
+            }
+            if (k == hold.first_tick) last_sample_[h] = pelvis;
+            else if ((k - hold.first_tick) % sample_every_ == 0 || k + 1 == hold.end_tick) {
+                const double dx = pelvis.x - last_sample_[h].x, dz = pelvis.z - last_sample_[h].z;
+                path_[h] += std::sqrt(dx * dx + dz * dz);
+                last_sample_[h] = pelvis;
+            }
+        }
+    }
+
+    const SimConfig& config_;
+    const Simulation& sim_;
+    const Terrain& terrain_;
+    const MeasuredPuppet& puppet_;
+    const std::vector<TickInput>& ticks_;
+    const std::vector<Hold> holds_;
+    GaitMetrics& m_;
+    PuppetState previous_;
+    bool airborne_[2] = {false, false};
+    bool in_flight_ = false;
+    vec3 stance_anchor_[2];
+    bool was_stance_[2] = {true, true};
+    // Per hold: pelvis path length (sampled every quarter second) and expected speed.
+    std::vector<double> path_, expected_;
+    std::vector<vec3> last_sample_;
+    const std::uint64_t sample_every_;
+    std::string csv_;  // the feet CSV, when asked for
+};
+
+void write_feet_csv(const std::string& path, const std::string& csv) {
+    std::FILE* out = std::fopen(path.c_str(), "wb");
+    if (!out || std::fwrite(csv.data(), 1, csv.size(), out) != csv.size())
+        throw std::runtime_error(path + ": cannot write the feet CSV");
+    std::fclose(out);
+}
+
+}  // namespace
 
 GaitMetrics evaluate_gait(const SimConfig& config, const StickProgram& program, const std::string& feet_csv,
                           std::shared_ptr<const MotionGraph> graph) {
-    std::string csv;
-    if (!feet_csv.empty())
-        csv = "tick,phase,speed,mode,pelvis_y,foot,swinging,progress,ankle_x,ankle_y,ankle_z,target_x,target_z,ankle_clear,sole_clear,ball_clear,tip_clear\n";
     const std::vector<TickInput> ticks = render_stick_program(program, config.tick_rate_hz);
-    const std::vector<Hold> holds = moving_holds(program, config);
+    std::vector<Hold> holds = moving_holds(program, config);
     set_simulation_float_mode();
     Simulation sim(config);
-    const Terrain& terrain = sim.terrain();
     GaitMetrics m;
-    FootGeometry feet[2] = {puppet_foot(kFootL), puppet_foot(kFootR)};
-    // Expected speed with a graph: the controller asks for stick deflection ×
-    // full_stick_speed leg lengths per second (no deadzone, curve or slope factor),
-    // and a leg is scaled to leg_metres (attach_motion_graph; a graph of the
-    // puppet's own skeleton is not scaled).
-    double graph_full_speed_m_s = static_cast<double>(config.graph_full_stick_speed) * config.graph_leg_metres;
-    if (graph) {
-        if (graph->left_foot < 0 || graph->right_foot < 0)
-            throw std::runtime_error("the motion graph names no left and right foot joints, so the foot metrics cannot be measured");
-        attach_motion_graph(sim, graph);
-        feet[0] = graph_foot(*graph, graph->left_foot, sim.metres_per_unit());
-        feet[1] = graph_foot(*graph, graph->right_foot, sim.metres_per_unit());
-        graph_full_speed_m_s = static_cast<double>(config.graph_full_stick_speed) *
-                               (graph->leg_length > 0.0f ? graph->leg_length : 1.0) * sim.metres_per_unit();
-        const std::int32_t source = sim.state().motion_source;
-        m.motion_source = source == kSourceGraphFeet ? "graph_feet" : source == kSourceGraph ? "graph" : "gait";
-        m.speed_expectation = "graph full_stick_speed x leg_metres x stick deflection";
-    }
-    const std::size_t pelvis_joint = graph ? 0 : static_cast<std::size_t>(kPelvis);
-
-    PuppetState previous = sim.state();
-    bool airborne[2] = {false, false};
-    bool in_flight = false;
-    vec3 stance_anchor[2] = {sim.state().model_positions[static_cast<std::size_t>(feet[0].ankle)],
-                             sim.state().model_positions[static_cast<std::size_t>(feet[1].ankle)]};
-    bool was_stance[2] = {true, true};
-    // Per hold: pelvis path length (sampled every quarter second) and expected speed.
-    std::vector<double> path(holds.size(), 0.0), expected(holds.size(), 0.0);
-    std::vector<vec3> last_sample(holds.size());
-    const std::uint64_t sample_every = static_cast<std::uint64_t>(config.tick_rate_hz / 4);
-
+    MeasuredPuppet puppet;
+    puppet.graph_full_speed_m_s = static_cast<double>(config.graph_full_stick_speed) * config.graph_leg_metres;
+    if (graph) puppet = drive_with_graph(sim, std::move(graph), config, m);
+    GaitMeter meter(config, sim, puppet, ticks, std::move(holds), !feet_csv.empty(), m);
     for (std::uint64_t k = 0; k < ticks.size(); ++k) {
         sim.step(ticks[k]);
-        const PuppetState& s = sim.state();
-        for (int i = 0; i < 2; ++i) {
-            const FootPoints fp = foot_points(s, feet[i], config);
-            double lowest = 1e9;
-            const bool stance = foot_in_stance(s, i);
-            for (int p_index = 0; p_index < fp.count; ++p_index) {
-                const vec3& p = fp.points[p_index];
-                const double clearance = static_cast<double>(p.y) - query_ground(terrain, p.x, p.z).height;
-                if (-clearance * 1000.0 > m.penetration_mm) {
-                    m.penetration_mm = -clearance * 1000.0;
-                    m.deepest_tick = s.tick;
-                    m.deepest_point = fmt::format("{} {} ({})", i == 0 ? "left" : "right", fp.names[p_index],
-                                                  stance ? "stance" : "swing");
-                }
-                lowest = std::min(lowest, clearance);
-            }
-            if (!feet_csv.empty()) {
-                const FootState& f = s.gait.feet[static_cast<std::size_t>(i)];
-                csv += fmt::format("{},{:.4f},{:.3f},{},{:.4f},{},{},{:.3f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f}", s.tick, s.gait.cycle_phase, s.gait.speed,
-                                   static_cast<int>(s.gait.mode), s.gait.pelvis.y, i, stance ? 0 : 1, f.progress, fp.points[0].x,
-                                   fp.points[0].y, fp.points[0].z, f.target.x, f.target.z);
-                for (int p_index = 0; p_index < 4; ++p_index) {
-                    const vec3& p = fp.points[p_index];
-                    if (p_index < fp.count) csv += fmt::format(",{:.4f}", p.y - query_ground(terrain, p.x, p.z).height);
-                    else csv += ",";
-                }
-                csv += "\n";
-            }
-            if (!airborne[i] && lowest > kAirborneM) airborne[i] = true;
-            else if (airborne[i] && lowest <= kGroundedM) {
-                airborne[i] = false;
-                ++m.steps;
-            }
-            // Skate: while the foot is in stance (foot_in_stance), its joint must not move.
-            const vec3 ankle = s.model_positions[static_cast<std::size_t>(feet[i].ankle)];
-            if (stance && !was_stance[i]) stance_anchor[i] = ankle;
-            if (stance) {
-                const double dx = ankle.x - stance_anchor[i].x, dz = ankle.z - stance_anchor[i].z;
-                const double skate = std::sqrt(dx * dx + dz * dz) * 1000.0;
-                if (skate > m.foot_skate_mm) {
-                    m.foot_skate_mm = skate;
-                    m.skate_tick = s.tick;
-                }
-            }
-            was_stance[i] = stance;
-        }
-        if (!in_flight && airborne[0] && airborne[1]) {
-            in_flight = true;
-            ++m.flight_phases;
-        } else if (in_flight && (!airborne[0] || !airborne[1])) {
-            in_flight = false;
-        }
-        const double dt_rate = config.tick_rate_hz;
-        for (int j = 0; j < s.joint_count; ++j) {
-            const std::size_t i = static_cast<std::size_t>(j);
-            const double speed = quat_angle_between(previous.local_rotations[i], s.local_rotations[i]) * dt_rate * det::kRadToDeg;
-            if (speed > m.max_joint_speed_deg_s) {
-                m.max_joint_speed_deg_s = speed;
-                m.fastest_joint = sim.skeleton().joint_names[i];
-                m.fastest_joint_tick = s.tick;
-            }
-        }
-        // Speed over the holds: measured from the pelvis (with a graph, its root)
-        // joint; expected from the stick through the documented response curve and
-        // slope factor, or with a graph the controller's own target speed.
-        const vec3 pelvis = s.model_positions[pelvis_joint];
-        for (std::size_t h = 0; h < holds.size(); ++h) {
-            const Hold& hold = holds[h];
-            if (k < hold.first_tick || k >= hold.end_tick) continue;
-            if (graph) {
-                const double sx = ticks[k].left_x / static_cast<double>(kStickScale);
-                const double sy = ticks[k].left_y / static_cast<double>(kStickScale);
-                expected[h] += graph_full_speed_m_s * std::sqrt(sx * sx + sy * sy);
-            } else {
-                const float deflection = std::min(1.0f, std::sqrt(hold.stick_x * hold.stick_x + hold.stick_y * hold.stick_y));
-                expected[h] += config.max_speed * stick_speed_fraction(deflection, config) *
-                               slope_speed_multiplier(terrain, config, pelvis.x, pelvis.z, s.heading);
-            }
-            if (k == hold.first_tick) last_sample[h] = pelvis;
-            else if ((k - hold.first_tick) % sample_every == 0 || k + 1 == hold.end_tick) {
-                const double dx = pelvis.x - last_sample[h].x, dz = pelvis.z - last_sample[h].z;
-                path[h] += std::sqrt(dx * dx + dz * dz);
-                last_sample[h] = pelvis;
-            }
-        }
-        previous = s;
+        meter.measure_tick(k);
     }
-    for (std::size_t h = 0; h < holds.size(); ++h) {
-        const double n = static_cast<double>(holds[h].end_tick - holds[h].first_tick);
-        if (holds[h].end_tick > ticks.size() || n < 2) continue;
-        const double seconds = (n - 1) / config.tick_rate_hz;
-        const double actual = path[h] / seconds;
-        const double want = expected[h] / n;
-        if (want <= 0.0) continue;
-        m.speed_error_pct = std::max(m.speed_error_pct, std::fabs(actual - want) / want * 100.0);
-        ++m.speed_windows;
-    }
-    if (!feet_csv.empty()) {
-        std::FILE* out = std::fopen(feet_csv.c_str(), "wb");
-        if (!out || std::fwrite(csv.data(), 1, csv.size(), out) != csv.size())
-            throw std::runtime_error(feet_csv + ": cannot write the feet CSV");
-        std::fclose(out);
-    }
+    meter.finish_speed_error();
+    if (!feet_csv.empty()) write_feet_csv(feet_csv, meter.feet_csv());
     m.ticks = ticks.size();
     m.final_hash = hash_state(sim.state());
     return m;

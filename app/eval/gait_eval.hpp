@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "runtime/errors/outcome.hpp"
 #include "runtime/graph/motion_graph.hpp"
 #include "runtime/sim/sim_config.hpp"
 #include "runtime/formats/stick_program.hpp"
@@ -42,12 +43,12 @@ inline constexpr double kMaxPenetrationMm = 1.0;
 inline constexpr double kMaxSpeedErrorPct = 2.0;
 inline constexpr double kMaxJointSpeedDegS = 1500.0;
 
-// Empty when every limit holds, else which failed and by how much.
-std::string gait_limit_failures(const GaitMetrics& metrics);
+// Ok when every limit holds, else which failed and by how much.
+Outcome check_gait_limits(const GaitMetrics& metrics);
 
-// Empty when every metric is a finite number, else the first that is not (the
+// Ok when every metric is a finite number, else the first that is not (the
 // only check `gait-eval --check --graph` applies: docs/gait.md).
-std::string gait_metric_non_finite(const GaitMetrics& metrics);
+Outcome check_gait_metrics_finite(const GaitMetrics& metrics);
 
 // Whether foot 0 (left) or 1 (right) is planted in `state`, as the metrics read
 // stance: the gait's plan (not swinging) when the gait drives the puppet, the

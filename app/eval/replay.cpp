@@ -42,7 +42,7 @@ std::string trace_csv_row(std::uint64_t tick, std::uint64_t state_hash, const ve
 }
 
 ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name, const ReplayOptions& options) {
-    const SimConfig config = config_from_text(log.header.config_text, log_name + " (embedded configuration)");
+    const SimConfig config = config_from_text(log.header.config_text, log_name + " (embedded configuration)").sim;
     if (static_cast<std::uint32_t>(config.tick_rate_hz) != log.header.tick_rate_hz)
         throw ImportError(log_name, 0,
                           fmt::format("header tick rate {} Hz disagrees with its configuration's {} Hz",
@@ -83,10 +83,10 @@ ReplayResult replay_log(const DecodedInputLog& log, const std::string& log_name,
     bool keep_going = !options.on_tick || options.on_tick(sim);
     for (size_t k = 0; k < log.ticks.size() && keep_going; ++k) {
         while (next_change < log.config_changes.size() && log.config_changes[next_change].before_tick <= k) {
-            const SimConfig next = apply_config_text(sim.config(), log.config_changes[next_change].config_text,
-                                                     fmt::format("{} (config change before tick {})", log_name, k));
-            if (std::string key = sim.retune(next); !key.empty())
-                throw ImportError(log_name, 0, "recorded configuration change alters " + key + ", which cannot change live");
+            const SimConfig next = apply_config_change(sim.config(), log.config_changes[next_change].config_text,
+                                                       fmt::format("{} (config change before tick {})", log_name, k));
+            if (const Outcome retuned = sim.retune(next); !retuned.ok())
+                throw ImportError(log_name, 0, "recorded configuration change alters " + retuned.problem() + ", which cannot change live");
             ++result.config_changes;
             ++next_change;
         }

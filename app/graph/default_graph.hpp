@@ -10,7 +10,7 @@
 #include "graph_builder/graph_builder.hpp"
 #include "runtime/anim/clip.hpp"
 #include "runtime/graph/motion_graph.hpp"
-#include "runtime/sim/sim_config.hpp"
+#include "app/config/app_config.hpp"
 
 namespace marionette {
 
@@ -34,12 +34,14 @@ struct DefaultGraphBuild {
     double build_ms = 0.0;           // wall time; not stored in the graph
 };
 
-// Clips → database (embedded config/graph_labels.toml labels) → builder with the
-// config's [motion_graph] parameters → pruned graph. The graph's build_seconds
+// Clips (locomotion captured from the gait of `config`) → database (embedded
+// config/graph_labels.toml labels) → builder with the [motion_graph] build
+// parameters `build_config` → pruned graph. The graph's build_seconds
 // stays 0 so its serialized bytes depend only on the inputs. Throws
 // std::runtime_error naming the label and why when a required label is cut off.
 // `hooks` as for offline::build_motion_graph (progress, plot size).
-DefaultGraphBuild build_default_motion_graph_report(const SimConfig& config, const offline::GraphBuildHooks& hooks = {});
-MotionGraph build_default_motion_graph(const SimConfig& config);
+DefaultGraphBuild build_default_motion_graph_report(const SimConfig& config, const GraphBuildConfig& build_config,
+                                                    const offline::GraphBuildHooks& hooks = {});
+MotionGraph build_default_motion_graph(const SimConfig& config, const GraphBuildConfig& build_config);
 
 }  // namespace marionette

@@ -27,7 +27,7 @@ void write_binary_file(const std::string& path, const std::vector<std::uint8_t>&
     if (!out) throw std::runtime_error(path + ": write failed: " + std::strerror(errno));
 }
 
-offline::GraphBuildParams graph_build_params(const SimConfig& c) {
+offline::GraphBuildParams graph_build_params(const GraphBuildConfig& c) {
     offline::GraphBuildParams p;
     p.analysis_rate_hz = c.graph_analysis_rate_hz;
     p.window_frames = c.graph_window_frames;
@@ -40,14 +40,15 @@ offline::GraphBuildParams graph_build_params(const SimConfig& c) {
     return p;
 }
 
-std::shared_ptr<const MotionGraph> load_graph_argument(const std::string& argument, const SimConfig& config) {
+std::shared_ptr<const MotionGraph> load_graph_argument(const std::string& argument, const SimConfig& config,
+                                                       const GraphBuildConfig& build) {
     if (argument.empty()) {
         const bool wants_graph = config.motion_source == MotionSourceSetting::graph ||
                                  config.motion_source == MotionSourceSetting::graph_feet;
         if (!wants_graph) return nullptr;
-        return std::make_shared<const MotionGraph>(build_default_motion_graph(config));
+        return std::make_shared<const MotionGraph>(build_default_motion_graph(config, build));
     }
-    if (argument == "default") return std::make_shared<const MotionGraph>(build_default_motion_graph(config));
+    if (argument == "default") return std::make_shared<const MotionGraph>(build_default_motion_graph(config, build));
     return std::make_shared<const MotionGraph>(load_motion_graph_file(argument));
 }
 

@@ -9,20 +9,22 @@
 
 #include "graph_builder/graph_builder.hpp"
 #include "runtime/graph/motion_graph.hpp"
-#include "runtime/sim/sim_config.hpp"
+#include "app/config/app_config.hpp"
 #include "runtime/sim/simulation.hpp"
 
 namespace marionette {
 
 MotionGraph load_motion_graph_file(const std::string& path);
 // `--graph` on record, replay and run: a .mgraph file, or "default" for the
-// embedded default graph built from the configuration's [motion_graph]
-// parameters (identical bytes every time, so a log recorded with it replays with it).
+// embedded default graph, captured from the gait of `config` and built with the
+// [motion_graph] build parameters `build` (identical bytes every time, so a log
+// recorded with it replays with it).
 // An empty argument gives the default graph when the configuration's [motion]
 // source is graph or graph_feet, and no graph (nullptr) otherwise.
-std::shared_ptr<const MotionGraph> load_graph_argument(const std::string& argument, const SimConfig& config);
+std::shared_ptr<const MotionGraph> load_graph_argument(const std::string& argument, const SimConfig& config,
+                                                       const GraphBuildConfig& build);
 void write_binary_file(const std::string& path, const std::vector<std::uint8_t>& bytes);
-offline::GraphBuildParams graph_build_params(const SimConfig& config);
+offline::GraphBuildParams graph_build_params(const GraphBuildConfig& config);
 
 // [motion_graph.buttons] resolved against the graph's labels: button bit → label
 // index, −1 for none. A label the graph lacks is a ConfigError naming the key and

@@ -50,8 +50,9 @@ void write_binary_file_atomically(const std::string& path, const std::vector<std
 }
 
 std::shared_ptr<const MotionGraph> load_graph_argument_rebuilding_stale(const std::string& argument,
-                                                                        const SimConfig& config) {
-    if (argument.empty() || argument == "default") return load_graph_argument(argument, config);
+                                                                        const SimConfig& config,
+                                                                        const GraphBuildConfig& build) {
+    if (argument.empty() || argument == "default") return load_graph_argument(argument, config, build);
     const std::vector<std::uint8_t> bytes = read_binary_file(argument);
     const std::uint64_t stored_hash = motion_graph_source_hash(bytes, argument);  // header only: cheap
     auto graph = std::make_shared<MotionGraph>(deserialize_motion_graph(bytes, argument));
@@ -71,7 +72,7 @@ std::shared_ptr<const MotionGraph> load_graph_argument_rebuilding_stale(const st
                    argument, missing.size(), missing.size() == 1 ? "is" : "are", missing.front());
         return graph;
     }
-    offline::GraphBuildParams params = graph_build_params(config);
+    offline::GraphBuildParams params = graph_build_params(build);
     const auto started = std::chrono::steady_clock::now();
     const offline::ClipDatabase db = load_graph_sources(sources, params.analysis_rate_hz);
     const std::uint64_t current_hash = offline::graph_source_hash(db.content_hash, params);

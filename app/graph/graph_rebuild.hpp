@@ -9,7 +9,7 @@
 #include "graph_builder/clip_database.hpp"
 #include "graph_builder/graph_builder.hpp"
 #include "runtime/graph/motion_graph.hpp"
-#include "runtime/sim/sim_config.hpp"
+#include "app/config/app_config.hpp"
 
 namespace marionette {
 
@@ -45,6 +45,7 @@ void write_binary_file_atomically(const std::string& path, const std::vector<std
 // used as it is. Replay must not use this: a rebuilt graph has other bytes than
 // the one the log was recorded with.
 std::shared_ptr<const MotionGraph> load_graph_argument_rebuilding_stale(const std::string& argument,
-                                                                        const SimConfig& config);
+                                                                        const SimConfig& config,
+                                                                        const GraphBuildConfig& build);
 
 }  // namespace marionette

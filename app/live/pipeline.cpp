@@ -38,7 +38,7 @@ void SimulationLoop::apply(const SimConfig& config, TickRecord::ConfigSource sou
     // checked when it was decoded, so retune cannot fail here. It copies the
     // configuration into the simulation's; the terrain is structural, so its
     // arrays have the same sizes and the copy reuses their storage.
-    if (!sim_.retune(config).empty()) return;
+    if (!sim_.retune(config).ok()) return;
     ++config_changes_;
     record_.kind = TickRecord::Kind::config_change;
     record_.config_source = source;
@@ -399,21 +399,25 @@ std::string config_diff(const SimConfig& from, const SimConfig& to) {
     return out.empty() ? "no change" : out;
 }
 
-std::string realtime_change(const SimConfig& a, const SimConfig& b) {
-    const std::int32_t SimConfig::*const keys[] = {&SimConfig::input_priority, &SimConfig::simulation_priority,
-                                                   &SimConfig::render_priority, &SimConfig::input_cpu,
-                                                   &SimConfig::simulation_cpu, &SimConfig::render_cpu,
-                                                   &SimConfig::lock_memory};
-    for (auto key : keys)
-        if (a.*key != b.*key) return "realtime (thread settings)";
-    return {};
-}
+// How often the writer looks at its inputs (records, stop request, config file):
+// a 5 ms wait between looks keeps it off the CPU the simulation may share.
+constexpr int kWriterPollMs = 5;
+constexpr std::int64_t kWriterPollNs = std::int64_t{kWriterPollMs} * 1'000'000;
+// Editors write in steps: a watched file is read once it has been quiet this long.
+constexpr std::int64_t kEditQuietNs = 100'000'000;
+// A log chunk is written at least this often while ticks are pending (real time).
+constexpr std::int64_t kLogFlushIntervalNs = 200'000'000;
+// The clock starts this long after the threads are made, so they are running by then.
+constexpr std::int64_t kThreadStartLeadNs = 20'000'000;
+// How often the starting thread looks whether the display has opened.
+constexpr std::int64_t kDisplayOpenPollNs = 1'000'000;
 
 // The writer's side of live tuning: validate an edit and hand it to the simulation.
 struct LiveTuning {
     std::unique_ptr<ConfigWatcher> watcher;
     SimConfig published;       // the newest configuration handed over
-    // Only its fixed-after-start part is read (motion_source_refusal), so this
+    RealtimeConfig realtime;   // the thread settings the run started with (fixed)
+    // Only its fixed-after-start part is read (motion_source_allowed), so this
     // thread may ask it while the simulation thread steps.
     const Simulation* simulation = nullptr;
     std::uint32_t version = 0;
@@ -422,30 +426,163 @@ struct LiveTuning {
     std::vector<SimConfig> history;
     std::int64_t dirty_since = -1;
 
+    // Waits up to kWriterPollMs for an edit of the watched file (without one,
+    // just waits) and hands the file over once it has been quiet for kEditQuietNs.
+    void wait_and_poll(PipelineShared& sh, std::FILE* err) {
+        if (!watcher) {
+            sleep_until_ns(monotonic_ns() + kWriterPollNs);
+            return;
+        }
+        pollfd p{watcher->fd(), POLLIN, 0};
+        if (poll(&p, 1, kWriterPollMs) > 0 && watcher->read_events()) dirty_since = monotonic_ns();
+        if (dirty_since >= 0 && monotonic_ns() - dirty_since >= kEditQuietNs) {
+            dirty_since = -1;
+            reload(sh, err);
+        }
+    }
+
     void reload(PipelineShared& sh, std::FILE* err) {
-        SimConfig next;
+        AppConfig next;
         try {
             next = load_config(watcher->path());
         } catch (const ConfigError& e) {
             fmt::print(err, "config: {}; keeping the previous configuration\n", e.what());
             return;
         }
-        std::string key = structural_change(published, next);
-        if (key.empty()) key = realtime_change(published, next);
-        if (key.empty() && simulation) key = simulation->motion_source_refusal(next);
-        if (!key.empty()) {
+        Outcome kept = structure_unchanged(published, next.sim);
+        if (kept.ok() && !(next.realtime == realtime)) kept = Outcome::failure("realtime (thread settings)");
+        if (kept.ok() && simulation) kept = simulation->motion_source_allowed(next.sim);
+        if (!kept.ok()) {
             fmt::print(err, "config: {}: {} cannot change while running (restart to apply it); keeping the previous configuration\n",
-                       watcher->path(), key);
+                       watcher->path(), kept.problem());
             return;
         }
-        if (serialize_config(next) == serialize_config(published)) return;
-        published = next;
-        history.push_back(next);
+        // The graph build keys are not the tick's: an edit of only those changes nothing here.
+        if (serialize_config(next.sim) == serialize_config(published)) return;
+        published = next.sim;
+        history.push_back(next.sim);
         ConfigUpdate& update = sh.config_updates.back();
         update.version = ++version;
-        update.config = next;
+        update.config = next.sim;
         sh.config_updates.publish();
     }
+};
+
+// The writer's outputs, fed from the simulation's records on the thread that
+// called run_pipeline: the input log, the trace, the status and notice lines,
+// and the run's distance and top speed.
+class RecordWriter {
+public:
+    RecordWriter(const PipelineOptions& o, const Simulation& sim, const PipelineShared& sh, const LiveTuning& tuning,
+                 PipelineResult& result)
+        : o_(o), sh_(sh), tuning_(tuning), result_(result), tick_rate_hz_(o.config.tick_rate_hz),
+          flush_ticks_(static_cast<std::uint32_t>(o.config.tick_rate_hz / 4)), logged_config_(o.config),
+          previous_root_(sim.state().root_position), last_flush_(monotonic_ns()) {
+        if (!o.record_file.empty()) {
+            InputLogHeader header;
+            header.tick_rate_hz = static_cast<std::uint32_t>(o.config.tick_rate_hz);
+            header.clip_data_hash = sim.clip_data_hash();
+            header.config_text = serialize_config(o.config);
+            log_ = std::make_unique<InputLogFile>(o.record_file, header);
+        }
+        if (!o.trace_file.empty()) {
+            trace_.reset(std::fopen(o.trace_file.c_str(), "wb"));
+            if (!trace_) throw std::runtime_error(o.trace_file + ": cannot create trace file");
+            std::fputs(trace_csv_header().c_str(), trace_.get());
+        }
+    }
+
+    void handle(const TickRecord& r) {
+        const double seconds = static_cast<double>(r.tick) / tick_rate_hz_;
+        if (r.kind == TickRecord::Kind::config_change) {
+            write_config_change(r, seconds);
+            return;
+        }
+        result_.ticks = r.tick;
+        const vec3 root(r.root_position[0], r.root_position[1], r.root_position[2]);
+        write_tick(r, root);
+        const vec3 d = root - previous_root_;
+        previous_root_ = root;
+        result_.distance_m += std::sqrt(static_cast<double>(d.x) * d.x + static_cast<double>(d.z) * d.z);
+        const float speed = std::sqrt(r.velocity[0] * r.velocity[0] + r.velocity[1] * r.velocity[1]);
+        if (speed > result_.top_speed) result_.top_speed = speed;
+        if (r.connected != connected_) note_connection(r.connected, seconds);
+        if (o_.status_lines && r.tick % static_cast<std::uint64_t>(tick_rate_hz_) == 0)
+            print_status_line(r, root, speed, seconds);
+    }
+
+    // Also by the clock, should ticks come slowly; virtual time flushes by tick
+    // count only, so its logs are byte-for-byte repeatable.
+    void flush_by_clock(std::int64_t now_ns) {
+        if (log_ && !o_.virtual_time && log_->pending_ticks() > 0 && now_ns - last_flush_ >= kLogFlushIntervalNs) {
+            log_->flush();
+            last_flush_ = now_ns;
+        }
+    }
+
+    void close() {
+        if (log_) log_->close();
+        if (trace_ && std::fclose(trace_.release()) != 0) throw std::runtime_error(o_.trace_file + ": write failed");
+    }
+
+private:
+    // A recorded change by its index, a live edit by its version.
+    void write_config_change(const TickRecord& r, double seconds) {
+        const SimConfig& applied = r.config_source == TickRecord::ConfigSource::recorded
+                                       ? o_.scheduled_changes.at(r.config_id).config
+                                       : tuning_.history.at(r.config_id - 1);
+        if (log_) log_->append_config_change(serialize_config(applied));
+        fmt::print(o_.out, "[{:6.1f} s] config: applied before tick {}: {}\n", seconds, r.tick,
+                   config_diff(logged_config_, applied));
+        logged_config_ = applied;
+    }
+
+    void write_tick(const TickRecord& r, const vec3& root) {
+        if (log_) {
+            log_->append_tick(r.input);
+            if (log_->pending_ticks() >= flush_ticks_) {
+                log_->flush();  // a chunk per 250 ms of ticks: kill -9 loses at most that
+                last_flush_ = monotonic_ns();
+            }
+        }
+        if (trace_ && std::fputs(trace_csv_row(r.tick, r.hash, root).c_str(), trace_.get()) < 0)
+            throw std::runtime_error(o_.trace_file + ": write failed");
+    }
+
+    void note_connection(bool connected, double seconds) {
+        connected_ = connected;
+        if (connected) fmt::print(o_.out, "[{:6.1f} s] controller connected: resuming\n", seconds);
+        else fmt::print(o_.out, "[{:6.1f} s] controller disconnected: the puppet idles until one is connected\n", seconds);
+        std::fflush(o_.out);
+    }
+
+    void print_status_line(const TickRecord& r, const vec3& root, float speed, double seconds) {
+        const PipelineCounters& c = sh_.counters;
+        fmt::print(o_.out,
+                   "[{:6.1f} s] {:<8} {:4.2f} m/s  heading {:4.0f}°  at ({:6.2f}, {:6.2f})  walked {:5.1f} m | "
+                   "tick max {:.0f} µs  input→tick max {:.1f} ms  frame max {:.0f} µs  frames {} (missed {})  "
+                   "dropped {}{}\n",
+                   seconds, connected_ ? activity(speed) : "idle", speed, r.heading * det::kRadToDeg, root.x, root.z,
+                   result_.distance_m, c.tick_time_max_ns.load(std::memory_order_relaxed) / 1e3,
+                   c.input_latency_max_ns.load(std::memory_order_relaxed) / 1e6,
+                   c.frame_time_max_ns.load(std::memory_order_relaxed) / 1e3,
+                   c.frames.load(std::memory_order_relaxed), c.missed_frames.load(std::memory_order_relaxed),
+                   c.samples_dropped.load(std::memory_order_relaxed), connected_ ? "" : "  [no controller]");
+        std::fflush(o_.out);
+    }
+
+    const PipelineOptions& o_;
+    const PipelineShared& sh_;
+    const LiveTuning& tuning_;
+    PipelineResult& result_;
+    const int tick_rate_hz_;
+    const std::uint32_t flush_ticks_;
+    std::unique_ptr<InputLogFile> log_;
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> trace_{nullptr, &std::fclose};
+    SimConfig logged_config_;  // the configuration the last change notice left in force
+    vec3 previous_root_;
+    bool connected_ = true;
+    std::int64_t last_flush_;
 };
 
 struct ThreadGuard {
@@ -458,236 +595,203 @@ struct ThreadGuard {
     }
 };
 
+// One run of the pipeline, in its phases: prepare (everything that allocates,
+// in the constructor), start the threads, write until the simulation is done,
+// shut down. Members are destroyed in reverse order, so the guard joins the
+// threads before anything they use goes away.
+class PipelineRun {
+public:
+    explicit PipelineRun(const PipelineOptions& o)
+        : o_(o), shared_(std::make_unique<PipelineShared>()), sh_(*shared_),
+          loop_(prepare_simulation(o, sh_)), writer_(o, loop_->simulation(), sh_, tuning_, result_),
+          tuning_(prepare_live_tuning(o, loop_->simulation())) {
+        if (o.realtime.lock_memory) note_realtime_failure(lock_all_memory());
+    }
+
+    void start() {
+        // Only this thread takes SIGINT/SIGTERM: the workers start with them blocked.
+        sigset_t stop_signals, previous_mask;
+        sigemptyset(&stop_signals);
+        sigaddset(&stop_signals, SIGINT);
+        sigaddset(&stop_signals, SIGTERM);
+        pthread_sigmask(SIG_BLOCK, &stop_signals, &previous_mask);
+        try {
+            start_threads();
+        } catch (...) {
+            pthread_sigmask(SIG_SETMASK, &previous_mask, nullptr);
+            throw;
+        }
+        pthread_sigmask(SIG_SETMASK, &previous_mask, nullptr);
+        apply_realtime_settings();
+    }
+
+    // The writer: this thread drains the records into the log, the trace and the
+    // status line, and watches for a stop, a closed window and config edits.
+    void write_until_done() {
+        TickRecord record;
+        for (;;) {
+            const bool finished = sh_.simulation_done.load(std::memory_order_acquire);
+            while (sh_.records.try_pop(record)) writer_.handle(record);
+            const std::int64_t now = monotonic_ns();
+            writer_.flush_by_clock(now);
+            if (finished) break;  // simulation_done was read before the last drain
+            if (stop_seen_ < 0 && o_.stop_request && o_.stop_request->load()) {
+                stop_seen_ = now;
+                result_.stopped = true;
+                sh_.stop.store(true);
+            }
+            if (o_.device) publish_device_counters();
+            if (!result_.display_closed && display_.closed.load(std::memory_order_acquire)) {
+                result_.display_closed = true;  // closing the window ends the run normally
+                sh_.stop.store(true);
+            }
+            tuning_.wait_and_poll(sh_, o_.err);
+        }
+    }
+
+    PipelineResult shut_down() {
+        sh_.stop.store(true);
+        if (o_.device) {
+            publish_device_counters();
+            device_->stop();
+        }
+        for (std::thread* t : guard_.threads)
+            if (t->joinable()) t->join();
+        TickRecord record;
+        while (sh_.records.try_pop(record)) writer_.handle(record);
+        writer_.close();
+        collect_result(monotonic_ns());
+        return result_;
+    }
+
+private:
+    static std::unique_ptr<SimulationLoop> prepare_simulation(const PipelineOptions& o, PipelineShared& sh) {
+        set_simulation_float_mode();
+        auto loop = std::make_unique<SimulationLoop>(o.config, sh, o.scheduled_changes, o.virtual_time);
+        if (o.graph) attach_motion_graph(loop->simulation_before_start(), o.graph);
+        return loop;
+    }
+
+    static LiveTuning prepare_live_tuning(const PipelineOptions& o, const Simulation& sim) {
+        LiveTuning tuning;
+        tuning.published = o.config;
+        tuning.realtime = o.realtime;
+        tuning.simulation = &sim;
+        if (!o.watch_config_file.empty()) tuning.watcher = std::make_unique<ConfigWatcher>(o.watch_config_file);
+        return tuning;
+    }
+
+    void start_threads() {
+        // The render thread first: the display must open before the clock starts.
+        start_display();
+        wall_start_ = monotonic_ns();
+        const std::int64_t t0 = o_.virtual_time ? 0 : wall_start_ + kThreadStartLeadNs;
+        // The input thread before the simulation thread: a device backend that
+        // cannot open its pad fails here, before any tick runs or is recorded.
+        if (o_.device) {
+            std::string error;
+            if (!device_->start(sh_.input_ring, *o_.device, error)) throw ImportError("--input " + o_.device->backend, 0, error);
+            result_.input_description = device_->backend_description();
+        } else {
+            in_thread_ = std::thread(input_thread, std::ref(sh_), std::cref(o_.script), t0, o_.virtual_time);
+        }
+        sim_thread_ = std::thread(simulation_thread, std::ref(sh_), std::ref(*loop_), o_.total_ticks, t0,
+                                  o_.virtual_time, !o_.script.stamp_when_read, std::ref(sim_result_));
+    }
+
+    void start_display() {
+        const Simulation& sim = loop_->simulation();
+        const RenderInputs inputs{&o_.display, &sim.skeleton(), &sim.terrain(), o_.config.ankle_height,
+                                  o_.config.tick_rate_hz};
+        gfx_thread_ = std::thread(render_thread, std::ref(sh_), o_.frame_rate_hz, o_.virtual_time, inputs,
+                                  std::ref(display_), std::ref(result_.frame_time));
+        while (display_.state.load(std::memory_order_acquire) == DisplayThreadState::opening)
+            sleep_until_ns(monotonic_ns() + kDisplayOpenPollNs);
+        if (display_.state.load(std::memory_order_acquire) == DisplayThreadState::failed) {
+            gfx_thread_.join();
+            throw render::PlatformError(display_.error);
+        }
+        result_.display_description = display_.description;
+    }
+
+    // [realtime]: priorities and CPUs, once the threads run. Virtual time waits
+    // by spinning: never under SCHED_FIFO, where a spinning thread would starve
+    // the writer it waits for.
+    void apply_realtime_settings() {
+        const RealtimeConfig& rt = o_.realtime;
+        const bool fifo = !o_.virtual_time;
+        note_realtime_failure(apply_thread_settings(o_.device ? device_->thread() : in_thread_, "mario-input",
+                                                    fifo ? rt.input_priority : 0, rt.input_cpu));
+        note_realtime_failure(apply_thread_settings(sim_thread_, "mario-sim", fifo ? rt.simulation_priority : 0,
+                                                    rt.simulation_cpu));
+        note_realtime_failure(apply_thread_settings(gfx_thread_, "mario-render", fifo ? rt.render_priority : 0,
+                                                    rt.render_cpu));
+        if (!result_.realtime_warning.empty())
+            fmt::print(o_.err, "warning: real-time settings not permitted ({}); running with normal scheduling\n",
+                       result_.realtime_warning);
+    }
+
+    void note_realtime_failure(const std::string& what) {
+        if (what.empty()) return;
+        result_.realtime_warning += (result_.realtime_warning.empty() ? "" : "; ") + what;
+    }
+
+    // The backend keeps its own counters; the status line reads these.
+    void publish_device_counters() {
+        const input::InputThreadStats st = device_->stats();
+        sh_.counters.samples_pushed.store(st.samples, std::memory_order_relaxed);
+        sh_.counters.samples_dropped.store(st.ring_dropped, std::memory_order_relaxed);
+    }
+
+    void collect_result(std::int64_t end) {
+        PipelineResult& r = result_;
+        if (r.stopped) {
+            std::int64_t from = stop_seen_;
+            if (o_.stop_request_time_ns && o_.stop_request_time_ns->load() > 0) from = o_.stop_request_time_ns->load();
+            r.shutdown_ms = static_cast<double>(end - from) / 1e6;
+        }
+        r.wall_s = static_cast<double>(end - wall_start_) / 1e9;
+        r.final_state = loop_->simulation().state();
+        r.ticks = r.final_state.tick;
+        r.final_hash = hash_state(r.final_state);
+        r.input_latency = loop_->input_latency();
+        r.tick_time = sim_result_.tick_time;
+        r.samples_pushed = sh_.counters.samples_pushed.load();
+        r.samples_dropped = sh_.counters.samples_dropped.load();
+        r.frames = sh_.counters.frames.load();
+        r.missed_frames = sh_.counters.missed_frames.load();
+        r.catch_up_drops = sim_result_.catch_up_drops;
+        r.records_dropped = sh_.counters.records_dropped.load();
+        r.config_changes = loop_->config_changes();
+        r.disconnects = loop_->assembler().disconnects();
+        r.reconnects = loop_->assembler().reconnects();
+    }
+
+    const PipelineOptions& o_;
+    PipelineResult result_;
+    std::unique_ptr<PipelineShared> shared_;
+    PipelineShared& sh_;
+    std::unique_ptr<SimulationLoop> loop_;
+    RecordWriter writer_;  // before tuning_, as the run made its outputs before watching the file
+    LiveTuning tuning_;
+    SimulationThreadResult sim_result_;
+    DisplayThreadState display_;
+    std::thread sim_thread_, in_thread_, gfx_thread_;
+    std::unique_ptr<input::InputThread> device_ = std::make_unique<input::InputThread>();  // stopped (joined) by its destructor
+    ThreadGuard guard_{{&sim_thread_, &in_thread_, &gfx_thread_}, sh_};
+    std::int64_t wall_start_ = 0;
+    std::int64_t stop_seen_ = -1;  // when the writer saw the stop request
+};
+
 }  // namespace
 
 // ---------------------------------------------------------------- the run
 
 PipelineResult run_pipeline(const PipelineOptions& o) {
-    PipelineResult result;
-    const SimConfig& config = o.config;
-    auto shared = std::make_unique<PipelineShared>();
-    PipelineShared& sh = *shared;
-
-    // Everything that allocates happens here, before the threads start.
-    set_simulation_float_mode();
-    auto loop = std::make_unique<SimulationLoop>(config, sh, o.scheduled_changes, o.virtual_time);
-    if (o.graph) attach_motion_graph(loop->simulation_before_start(), o.graph);
-    std::unique_ptr<InputLogFile> log;
-    if (!o.record_file.empty()) {
-        InputLogHeader header;
-        header.tick_rate_hz = static_cast<std::uint32_t>(config.tick_rate_hz);
-        header.clip_data_hash = loop->simulation().clip_data_hash();
-        header.config_text = serialize_config(config);
-        log = std::make_unique<InputLogFile>(o.record_file, header);
-    }
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> trace(nullptr, &std::fclose);
-    if (!o.trace_file.empty()) {
-        trace.reset(std::fopen(o.trace_file.c_str(), "wb"));
-        if (!trace) throw std::runtime_error(o.trace_file + ": cannot create trace file");
-        std::fputs(trace_csv_header().c_str(), trace.get());
-    }
-    LiveTuning tuning;
-    tuning.published = config;
-    tuning.simulation = &loop->simulation();
-    if (!o.watch_config_file.empty()) tuning.watcher = std::make_unique<ConfigWatcher>(o.watch_config_file);
-
-    std::string realtime_failed;
-    auto note_failure = [&](const std::string& what) {
-        if (!what.empty()) realtime_failed += (realtime_failed.empty() ? "" : "; ") + what;
-    };
-    if (config.lock_memory) note_failure(lock_all_memory());
-
-    // Only this thread takes SIGINT/SIGTERM: the workers start with them blocked.
-    sigset_t stop_signals, previous_mask;
-    sigemptyset(&stop_signals);
-    sigaddset(&stop_signals, SIGINT);
-    sigaddset(&stop_signals, SIGTERM);
-    pthread_sigmask(SIG_BLOCK, &stop_signals, &previous_mask);
-
-    SimulationThreadResult sim_result;
-    DisplayThreadState display;
-    RenderInputs render_inputs{&o.display, &loop->simulation().skeleton(), &loop->simulation().terrain(),
-                               config.ankle_height, config.tick_rate_hz};
-    std::thread sim_thread, in_thread, gfx_thread;
-    auto device = std::make_unique<input::InputThread>();  // stopped (joined) by its destructor
-    ThreadGuard guard{{&sim_thread, &in_thread, &gfx_thread}, sh};
-    std::int64_t wall_start = 0;
-    try {
-        // The render thread first: the display must open before the clock starts.
-        gfx_thread = std::thread(render_thread, std::ref(sh), o.frame_rate_hz, o.virtual_time, render_inputs,
-                                 std::ref(display), std::ref(result.frame_time));
-        while (display.state.load(std::memory_order_acquire) == DisplayThreadState::opening)
-            sleep_until_ns(monotonic_ns() + 1'000'000);
-        if (display.state.load(std::memory_order_acquire) == DisplayThreadState::failed) {
-            gfx_thread.join();
-            throw render::PlatformError(display.error);
-        }
-        result.display_description = display.description;
-        wall_start = monotonic_ns();
-        const std::int64_t t0 = o.virtual_time ? 0 : wall_start + 20'000'000;  // let the threads start first
-        // The input thread before the simulation thread: a device backend that
-        // cannot open its pad fails here, before any tick runs or is recorded.
-        if (o.device) {
-            std::string error;
-            if (!device->start(sh.input_ring, *o.device, error)) throw ImportError("--input " + o.device->backend, 0, error);
-            result.input_description = device->backend_description();
-        } else {
-            in_thread = std::thread(input_thread, std::ref(sh), std::cref(o.script), t0, o.virtual_time);
-        }
-        sim_thread = std::thread(simulation_thread, std::ref(sh), std::ref(*loop), o.total_ticks, t0, o.virtual_time,
-                                 !o.script.stamp_when_read, std::ref(sim_result));
-    } catch (...) {
-        pthread_sigmask(SIG_SETMASK, &previous_mask, nullptr);
-        throw;
-    }
-    pthread_sigmask(SIG_SETMASK, &previous_mask, nullptr);
-    // Virtual time waits by spinning: never under SCHED_FIFO, where a spinning
-    // thread would starve the writer it waits for.
-    const bool fifo = !o.virtual_time;
-    note_failure(apply_thread_settings(o.device ? device->thread() : in_thread, "mario-input", fifo ? config.input_priority : 0, config.input_cpu));
-    note_failure(apply_thread_settings(sim_thread, "mario-sim", fifo ? config.simulation_priority : 0, config.simulation_cpu));
-    note_failure(apply_thread_settings(gfx_thread, "mario-render", fifo ? config.render_priority : 0, config.render_cpu));
-    if (!realtime_failed.empty()) {
-        result.realtime_warning = realtime_failed;
-        fmt::print(o.err, "warning: real-time settings not permitted ({}); running with normal scheduling\n",
-                   realtime_failed);
-    }
-
-    // The writer: this thread drains the records into the log, the trace and the
-    // status line, and watches the configuration file.
-    const std::uint32_t flush_ticks = static_cast<std::uint32_t>(config.tick_rate_hz / 4);
-    const std::uint64_t ticks_per_second = static_cast<std::uint64_t>(config.tick_rate_hz);
-    std::int64_t last_flush = monotonic_ns();
-    std::int64_t stop_seen = -1;
-    bool connected = true;
-    vec3 previous_root = loop->simulation().state().root_position;
-    SimConfig logged_config = config;
-    std::string row;
-    auto handle = [&](const TickRecord& r) {
-        const double seconds = static_cast<double>(r.tick) / config.tick_rate_hz;
-        if (r.kind == TickRecord::Kind::config_change) {
-            const SimConfig& applied = r.config_source == TickRecord::ConfigSource::recorded
-                                           ? o.scheduled_changes.at(r.config_id).config
-                                           : tuning.history.at(r.config_id - 1);
-            if (log) log->append_config_change(serialize_config(applied));
-            fmt::print(o.out, "[{:6.1f} s] config: applied before tick {}: {}\n", seconds, r.tick,
-                       config_diff(logged_config, applied));
-            logged_config = applied;
-            return;
-        }
-        result.ticks = r.tick;
-        if (log) {
-            log->append_tick(r.input);
-            if (log->pending_ticks() >= flush_ticks) {
-                log->flush();  // a chunk per 250 ms of ticks: kill -9 loses at most that
-                last_flush = monotonic_ns();
-            }
-        }
-        const vec3 root(r.root_position[0], r.root_position[1], r.root_position[2]);
-        if (trace && std::fputs(trace_csv_row(r.tick, r.hash, root).c_str(), trace.get()) < 0)
-            throw std::runtime_error(o.trace_file + ": write failed");
-        const vec3 d = root - previous_root;
-        previous_root = root;
-        result.distance_m += std::sqrt(static_cast<double>(d.x) * d.x + static_cast<double>(d.z) * d.z);
-        const float speed = std::sqrt(r.velocity[0] * r.velocity[0] + r.velocity[1] * r.velocity[1]);
-        if (speed > result.top_speed) result.top_speed = speed;
-        if (r.connected != connected) {
-            connected = r.connected;
-            if (connected) fmt::print(o.out, "[{:6.1f} s] controller connected: resuming\n", seconds);
-            else fmt::print(o.out, "[{:6.1f} s] controller disconnected: the puppet idles until one is connected\n", seconds);
-            std::fflush(o.out);
-        }
-        if (o.status_lines && r.tick % ticks_per_second == 0) {
-            const PipelineCounters& c = sh.counters;
-            fmt::print(o.out,
-                       "[{:6.1f} s] {:<8} {:4.2f} m/s  heading {:4.0f}°  at ({:6.2f}, {:6.2f})  walked {:5.1f} m | "
-                       "tick max {:.0f} µs  input→tick max {:.1f} ms  frame max {:.0f} µs  frames {} (missed {})  "
-                       "dropped {}{}\n",
-                       seconds, connected ? activity(speed) : "idle", speed, r.heading * det::kRadToDeg,
-                       root.x, root.z, result.distance_m,
-                       c.tick_time_max_ns.load(std::memory_order_relaxed) / 1e3,
-                       c.input_latency_max_ns.load(std::memory_order_relaxed) / 1e6,
-                       c.frame_time_max_ns.load(std::memory_order_relaxed) / 1e3,
-                       c.frames.load(std::memory_order_relaxed), c.missed_frames.load(std::memory_order_relaxed),
-                       c.samples_dropped.load(std::memory_order_relaxed), connected ? "" : "  [no controller]");
-            std::fflush(o.out);
-        }
-    };
-    TickRecord record;
-    for (;;) {
-        const bool finished = sh.simulation_done.load(std::memory_order_acquire);
-        while (sh.records.try_pop(record)) handle(record);
-        const std::int64_t now = monotonic_ns();
-        // And by the clock, should ticks come slowly; virtual time flushes by tick
-        // count only, so its logs are byte-for-byte repeatable.
-        if (log && !o.virtual_time && log->pending_ticks() > 0 && now - last_flush >= 200'000'000) {
-            log->flush();
-            last_flush = now;
-        }
-        if (finished) break;  // simulation_done was read before the last drain
-        if (stop_seen < 0 && o.stop_request && o.stop_request->load()) {
-            stop_seen = now;
-            result.stopped = true;
-            sh.stop.store(true);
-        }
-        if (o.device) {
-            // The backend keeps its own counters; the status line reads these.
-            const input::InputThreadStats st = device->stats();
-            sh.counters.samples_pushed.store(st.samples, std::memory_order_relaxed);
-            sh.counters.samples_dropped.store(st.ring_dropped, std::memory_order_relaxed);
-        }
-        if (!result.display_closed && display.closed.load(std::memory_order_acquire)) {
-            result.display_closed = true;  // closing the window ends the run normally
-            sh.stop.store(true);
-        }
-        if (tuning.watcher) {
-            pollfd p{tuning.watcher->fd(), POLLIN, 0};
-            if (poll(&p, 1, 5) > 0 && tuning.watcher->read_events()) tuning.dirty_since = monotonic_ns();
-            // Editors write in steps: read the file once it has been quiet for 100 ms.
-            if (tuning.dirty_since >= 0 && monotonic_ns() - tuning.dirty_since >= 100'000'000) {
-                tuning.dirty_since = -1;
-                tuning.reload(sh, o.err);
-            }
-        } else {
-            sleep_until_ns(monotonic_ns() + 5'000'000);
-        }
-    }
-    sh.stop.store(true);
-    if (o.device) {
-        const input::InputThreadStats st = device->stats();
-        sh.counters.samples_pushed.store(st.samples);
-        sh.counters.samples_dropped.store(st.ring_dropped);
-        device->stop();
-    }
-    for (std::thread* t : guard.threads)
-        if (t->joinable()) t->join();
-    while (sh.records.try_pop(record)) handle(record);
-    if (log) log->close();
-    if (trace) {
-        if (std::fclose(trace.release()) != 0) throw std::runtime_error(o.trace_file + ": write failed");
-    }
-    const std::int64_t end = monotonic_ns();
-    if (result.stopped) {
-        std::int64_t from = stop_seen;
-        if (o.stop_request_time_ns && o.stop_request_time_ns->load() > 0) from = o.stop_request_time_ns->load();
-        result.shutdown_ms = static_cast<double>(end - from) / 1e6;
-    }
-    result.wall_s = static_cast<double>(end - wall_start) / 1e9;
-    result.final_state = loop->simulation().state();
-    result.ticks = result.final_state.tick;
-    result.final_hash = hash_state(result.final_state);
-    result.input_latency = loop->input_latency();
-    result.tick_time = sim_result.tick_time;
-    result.samples_pushed = sh.counters.samples_pushed.load();
-    result.samples_dropped = sh.counters.samples_dropped.load();
-    result.frames = sh.counters.frames.load();
-    result.missed_frames = sh.counters.missed_frames.load();
-    result.catch_up_drops = sim_result.catch_up_drops;
-    result.records_dropped = sh.counters.records_dropped.load();
-    result.config_changes = loop->config_changes();
-    result.disconnects = loop->assembler().disconnects();
-    result.reconnects = loop->assembler().reconnects();
-    return result;
+    PipelineRun run(o);
+    run.start();
+    run.write_until_done();
+    return run.shut_down();
 }
 
 }  // namespace marionette

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "app/config/app_config.hpp"
 #include "render_es/platform.hpp"
 #include "render_es/settings.hpp"
 #include "runtime/formats/input_log.hpp"
@@ -204,6 +205,7 @@ struct InputThreadOptions;
 
 struct PipelineOptions {
     SimConfig config;
+    RealtimeConfig realtime;           // thread settings, applied at start only
     InputScript script;
     // A real controller (input/input_thread.hpp) instead of the script: its own
     // thread pushes into the input ring; the run lasts until stopped.

@@ -5,13 +5,14 @@
 #include <sys/mman.h>
 
 #include <cstring>
+#include <string>
 
 namespace marionette {
 
-std::string apply_thread_settings(std::thread& thread, const char* name, int priority, int cpu) {
+Outcome apply_thread_settings(std::thread& thread, const char* name, int priority, int cpu) {
     // A thread that was never started (no script input thread when a device
     // backend reads the pad) has no pthread: naming handle 0 would crash.
-    if (!thread.joinable()) return {};
+    if (!thread.joinable()) return Outcome::success();
     const pthread_t handle = thread.native_handle();
     pthread_setname_np(handle, name);  // best effort: only for tools like top and gdb
     std::string failed;
@@ -29,12 +30,12 @@ std::string apply_thread_settings(std::thread& thread, const char* name, int pri
             failed += (failed.empty() ? "" : "; ") + std::string(name) + " thread on CPU " + std::to_string(cpu) +
                       ": " + std::strerror(rc);
     }
-    return failed;
+    return failed.empty() ? Outcome::success() : Outcome::failure(failed);
 }
 
-std::string lock_all_memory() {
-    if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) return std::string("mlockall: ") + std::strerror(errno);
-    return {};
+Outcome lock_all_memory() {
+    if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) return Outcome::failure(std::string("mlockall: ") + std::strerror(errno));
+    return Outcome::success();
 }
 
 }  // namespace marionette

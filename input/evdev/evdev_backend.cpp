@@ -34,8 +34,8 @@ std::vector<std::string> event_nodes(const std::string& dir) {
 std::vector<EvdevDeviceInfo> enumerate_evdev_gamepads(const std::string& dir) {
     std::vector<EvdevDeviceInfo> out;
     for (const std::string& path : event_nodes(dir)) {
-        std::string error;
-        if (auto pad = EvdevPad::open(path, error))
+        std::unique_ptr<EvdevPad> pad;
+        if (EvdevPad::open(path, pad).ok())
             out.push_back({path, pad->name(), pad->vendor_id(), pad->product_id()});
     }
     return out;
@@ -49,11 +49,8 @@ EvdevBackend::~EvdevBackend() {
     if (epoll_fd_ >= 0) ::close(epoll_fd_);
 }
 
-bool EvdevBackend::watch_directory(const std::string& dir, std::string& error) {
-    if (epoll_fd_ < 0) {
-        error = std::string("epoll_create1: ") + std::strerror(errno);
-        return false;
-    }
+Outcome EvdevBackend::watch_directory(const std::string& dir) {
+    if (epoll_fd_ < 0) return Outcome::failure(std::string("epoll_create1: ") + std::strerror(errno));
     dir_ = dir;
     inotify_fd_ = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
     if (inotify_fd_ >= 0) {
@@ -64,7 +61,7 @@ bool EvdevBackend::watch_directory(const std::string& dir, std::string& error) {
         add_watch();
     }
     scan_directory();
-    return true;
+    return Outcome::success();
 }
 
 bool EvdevBackend::add_watch() {
@@ -75,20 +72,17 @@ bool EvdevBackend::add_watch() {
     return watching_;
 }
 
-bool EvdevBackend::open_device(const std::string& path, std::string& error) {
+Outcome EvdevBackend::open_device(const std::string& path) {
     const std::size_t slash = path.rfind('/');
     only_path_ = path;
-    std::string ignored;
-    if (!watch_directory(slash == std::string::npos ? "." : path.substr(0, slash), ignored)) {
-        error = ignored;
-        return false;
-    }
+    if (Outcome watched = watch_directory(slash == std::string::npos ? "." : path.substr(0, slash)); !watched.ok())
+        return watched;
     if (connected() == 0) {
-        EvdevPad::open(path, error);  // for the message
-        if (error.empty()) error = path + ": cannot open";
-        return false;
+        std::unique_ptr<EvdevPad> probe;
+        const Outcome opened = EvdevPad::open(path, probe);  // for the message
+        return Outcome::failure(opened.ok() ? path + ": cannot open" : opened.problem());
     }
-    return true;
+    return Outcome::success();
 }
 
 void EvdevBackend::scan_directory() {
@@ -104,9 +98,8 @@ bool EvdevBackend::try_open(const std::string& path) {
         if (!p && free_slot < 0) free_slot = i;
     }
     if (free_slot < 0) return true;
-    std::string error;
-    auto pad = EvdevPad::open(path, error);
-    if (!pad) return false;
+    std::unique_ptr<EvdevPad> pad;
+    if (!EvdevPad::open(path, pad).ok()) return false;
     pad->set_apply_flat(!raw_);
     epoll_event ev{};
     ev.events = EPOLLIN;

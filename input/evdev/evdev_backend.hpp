@@ -33,9 +33,9 @@ public:
     EvdevBackend& operator=(const EvdevBackend&) = delete;
 
     // Watch a directory: open its gamepads now and whenever one appears.
-    bool watch_directory(const std::string& dir, std::string& error);
+    Outcome watch_directory(const std::string& dir);
     // One node only (--device PATH); reopened if it reappears in its directory.
-    bool open_device(const std::string& path, std::string& error);
+    Outcome open_device(const std::string& path);
 
     // Waits up to timeout_ms, then returns the samples read (at most out.size()).
     int poll(std::span<InputSample> out, int timeout_ms);

@@ -30,24 +30,22 @@ bool evdev_is_gamepad(const libevdev* dev) {
            libevdev_has_event_code(dev, EV_ABS, ABS_Y);
 }
 
-std::unique_ptr<EvdevPad> EvdevPad::open(const std::string& path, std::string& error) {
+Outcome EvdevPad::open(const std::string& path, std::unique_ptr<EvdevPad>& opened) {
+    opened.reset();
     const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) {
-        error = path + ": " + std::strerror(errno);
-        return nullptr;
+        return Outcome::failure(path + ": " + std::strerror(errno));
     }
     libevdev* dev = nullptr;
     const int rc = libevdev_new_from_fd(fd, &dev);
     if (rc < 0) {
-        error = path + ": libevdev cannot read the device: " + std::strerror(-rc);
         ::close(fd);
-        return nullptr;
+        return Outcome::failure(path + ": libevdev cannot read the device: " + std::strerror(-rc));
     }
     if (!evdev_is_gamepad(dev)) {
-        error = path + ": not a gamepad (needs BTN_GAMEPAD and ABS_X/ABS_Y)";
         libevdev_free(dev);
         ::close(fd);
-        return nullptr;
+        return Outcome::failure(path + ": not a gamepad (needs BTN_GAMEPAD and ABS_X/ABS_Y)");
     }
     std::unique_ptr<EvdevPad> pad(new EvdevPad());
     pad->fd_ = fd;
@@ -71,7 +69,8 @@ std::unique_ptr<EvdevPad> EvdevPad::open(const std::string& path, std::string& e
         state.set_axis_info(i, info->minimum, info->maximum, info->fuzz, info->flat, info->value);
     }
     for (std::uint16_t code : kReadKeys) state.set_key(code, libevdev_get_event_value(dev, EV_KEY, code) != 0);
-    return pad;
+    opened = std::move(pad);
+    return Outcome::success();
 }
 
 EvdevPad::~EvdevPad() {

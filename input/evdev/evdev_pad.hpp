@@ -11,6 +11,7 @@
 
 #include "input/evdev/evdev_state.hpp"
 #include "input/input_sample.hpp"
+#include "runtime/errors/outcome.hpp"
 
 struct libevdev;
 
@@ -18,9 +19,9 @@ namespace marionette::input {
 
 class EvdevPad {
 public:
-    // Opens and checks the node; null with `error` set when it cannot be opened
-    // or is not a gamepad.
-    static std::unique_ptr<EvdevPad> open(const std::string& path, std::string& error);
+    // Opens and checks the node into `pad`; fails (leaving `pad` null) when it
+    // cannot be opened or is not a gamepad.
+    static Outcome open(const std::string& path, std::unique_ptr<EvdevPad>& pad);
     ~EvdevPad();
     EvdevPad(const EvdevPad&) = delete;
     EvdevPad& operator=(const EvdevPad&) = delete;

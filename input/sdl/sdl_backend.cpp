@@ -8,24 +8,22 @@ namespace marionette::input {
 
 SdlBackend::~SdlBackend() { stop(); }
 
-bool SdlBackend::start(const std::string& mapping_file, std::string& error) {
+Outcome SdlBackend::start(const std::string& mapping_file) {
     SDL_SetHint(SDL_HINT_NO_SIGNAL_HANDLERS, "1");
     SDL_SetHint(SDL_HINT_JOYSTICK_ALLOW_BACKGROUND_EVENTS, "1");
-    if (SDL_InitSubSystem(SDL_INIT_GAMECONTROLLER | SDL_INIT_EVENTS) != 0) {
-        error = std::string("SDL2 cannot start its game controller subsystem: ") + SDL_GetError();
-        return false;
-    }
+    if (SDL_InitSubSystem(SDL_INIT_GAMECONTROLLER | SDL_INIT_EVENTS) != 0)
+        return Outcome::failure(std::string("SDL2 cannot start its game controller subsystem: ") + SDL_GetError());
     started_ = true;
     if (!mapping_file.empty()) {
         mappings_ = SDL_GameControllerAddMappingsFromFile(mapping_file.c_str());
         if (mappings_ < 0) {
-            error = mapping_file + ": SDL2 cannot read the mapping file: " + SDL_GetError();
+            Outcome unread = Outcome::failure(mapping_file + ": SDL2 cannot read the mapping file: " + SDL_GetError());
             stop();
-            return false;
+            return unread;
         }
     }
     open_first();
-    return true;
+    return Outcome::success();
 }
 
 void SdlBackend::stop() {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "input/input_sample.hpp"
+#include "runtime/errors/outcome.hpp"
 
 typedef struct _SDL_GameController SDL_GameController;
 
@@ -20,9 +21,9 @@ public:
     SdlBackend& operator=(const SdlBackend&) = delete;
 
     // Initialises SDL's game controller subsystem and loads the mapping file
-    // (gamecontrollerdb.txt format) when one is named. False with `error` set
-    // when SDL cannot start or the file cannot be read.
-    bool start(const std::string& mapping_file, std::string& error);
+    // (gamecontrollerdb.txt format) when one is named. Fails when SDL cannot
+    // start or the file cannot be read.
+    Outcome start(const std::string& mapping_file);
     // Waits up to timeout_ms; at most one sample per call (the open controller's state).
     int poll(std::span<InputSample> out, int timeout_ms);
     void stop();

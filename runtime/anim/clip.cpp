@@ -4,16 +4,16 @@
 
 namespace marionette {
 
-std::string validate_clip(const Clip& clip) {
-    if (std::string e = validate_skeleton(clip.skeleton); !e.empty()) return e;
-    if (!(clip.frame_rate > 0.0) || !std::isfinite(clip.frame_rate)) return "frame rate must be positive";
-    if (clip.frame_count < 1) return "clip has no frames";
+Outcome validate_clip(const Clip& clip) {
+    if (Outcome skeleton = validate_skeleton(clip.skeleton); !skeleton.ok()) return skeleton;
+    if (!(clip.frame_rate > 0.0) || !std::isfinite(clip.frame_rate)) return Outcome::failure("frame rate must be positive");
+    if (clip.frame_count < 1) return Outcome::failure("clip has no frames");
     const size_t expected = static_cast<size_t>(clip.frame_count) * static_cast<size_t>(clip.joint_count());
     if (clip.rotations.size() != expected || clip.translations.size() != expected)
-        return "pose arrays do not hold frame_count × joint_count entries";
+        return Outcome::failure("pose arrays do not hold frame_count × joint_count entries");
     if (clip.animated_translation.size() != static_cast<size_t>(clip.joint_count()))
-        return "animated_translation must have one flag per joint";
-    return {};
+        return Outcome::failure("animated_translation must have one flag per joint");
+    return Outcome::success();
 }
 
 void sample_clip(const Clip& clip, double time_seconds, ClipWrap wrap, std::span<quat> out_rotations,

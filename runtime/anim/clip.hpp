@@ -32,8 +32,8 @@ struct Clip {
     }
 };
 
-// Empty string when sizes and the skeleton are consistent, otherwise what is wrong.
-std::string validate_clip(const Clip& clip);
+// Ok when sizes and the skeleton are consistent, otherwise what is wrong.
+Outcome validate_clip(const Clip& clip);
 
 enum class ClipWrap { clamp, loop };
 

@@ -15,7 +15,6 @@ vec3 unit_or(vec3 v, vec3 fallback) {
     const float n = length_of(v);
     return n > 1e-6f ? v / n : fallback;
 }
-bool finite(vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 }  // namespace
 
 FootPlacementRig make_foot_placement_rig(std::span<const int> parents, int left_ankle, int right_ankle) {
@@ -45,15 +44,15 @@ FootPlacementRig make_foot_placement_rig(std::span<const int> parents, int left_
 bool FootPlacementJob::validate() const {
     const size_t n = parents.size();
     if (!state || !rig || !terrain || !rig->valid || !(dt >= 0.0f) || !(release_s >= 0.0f) || !(terrain_rate > 0.0f)) return false;
-    if (local_rotations.size() != n || local_translations.size() != n || model_rotations.size() != n || model_positions.size() != n)
-        return false;
+    if (!pose.has_joints(n) || !parents_in_topological_order(parents)) return false;
+    const auto is_joint = [n](std::int32_t j) { return j >= 0 && static_cast<size_t>(j) < n; };
     for (const FootPlacementLeg& leg : rig->legs)
-        if (leg.ankle < 0 || static_cast<size_t>(leg.ankle) >= n) return false;
-    return static_cast<size_t>(rig->root) < n;
+        if (!is_joint(leg.hip) || !is_joint(leg.knee) || !is_joint(leg.ankle)) return false;
+    return is_joint(rig->root);
 }
 
-void FootPlacementJob::run() const {
-    if (!validate()) return;
+bool FootPlacementJob::run() const {
+    if (!validate()) return false;
     FootPlacementState& s = *state;
     const vec3 up(0.0f, 1.0f, 0.0f);
 
@@ -63,7 +62,7 @@ void FootPlacementJob::run() const {
     bool slow[2];
     for (int i = 0; i < 2; ++i) {
         FootPin& pin = s.feet[static_cast<size_t>(i)];
-        const vec3 a = model_positions[static_cast<size_t>(rig->legs[static_cast<size_t>(i)].ankle)];
+        const vec3 a = pose.model_positions[static_cast<size_t>(rig->legs[static_cast<size_t>(i)].ankle)];
         sample[i] = query_ground(*terrain, a.x, a.z);
         const vec3 moved = s.started ? a - pin.clip_previous : vec3(0.0f);
         const float step = std::sqrt(moved.x * moved.x + moved.z * moved.z);
@@ -87,17 +86,17 @@ void FootPlacementJob::run() const {
     if (!s.started) s.body_offset = lowest;
     else s.body_offset += (lowest - s.body_offset) * clamp01(terrain_rate * dt);
     const size_t root = static_cast<size_t>(rig->root);
-    local_translations[root].y += s.body_offset;
-    for (vec3& p : model_positions) p.y += s.body_offset;
+    pose.local_translations[root].y += s.body_offset;
+    for (vec3& p : pose.model_positions) p.y += s.body_offset;
 
-    const vec3 forward = quat_rotate(model_rotations[root], vec3(0.0f, 0.0f, 1.0f));
+    const vec3 forward = quat_rotate(pose.model_rotations[root], vec3(0.0f, 0.0f, 1.0f));
     for (int i = 0; i < 2; ++i) {
         const FootPlacementLeg& leg = rig->legs[static_cast<size_t>(i)];
         FootPin& pin = s.feet[static_cast<size_t>(i)];
         const size_t hip = static_cast<size_t>(leg.hip), knee = static_cast<size_t>(leg.knee),
                      ankle = static_cast<size_t>(leg.ankle);
         // The clip's ankle, as high above the ground under it as it was above its flat floor.
-        const vec3 free = model_positions[ankle] + vec3(0.0f, pin.ground - s.body_offset, 0.0f);
+        const vec3 free = pose.model_positions[ankle] + vec3(0.0f, pin.ground - s.body_offset, 0.0f);
         const bool contact = ((contacts >> i) & 1u) && slow[i];
         if (contact && pin.contact == 0) {
             pin.pin = s.started ? pin.placed : free;
@@ -124,39 +123,41 @@ void FootPlacementJob::run() const {
                                : clamp01(pin.plant + (pin.contact == 1 ? plant_step : -plant_step));
         const vec3 target = lerp(pin.pin, free, smoothstep(pin.release));
 
-        const vec3 h = model_positions[hip], k = model_positions[knee], a = model_positions[ankle];
-        TwoBoneIkInput ik;
+        const vec3 h = pose.model_positions[hip], k = pose.model_positions[knee], a = pose.model_positions[ankle];
+        TwoBoneIkJob ik;
         ik.root = h;
         ik.target = target;
         ik.pole = unit_or(k - 0.5f * (h + a), forward);
-        ik.upper_length = length_of(local_translations[knee]);
-        ik.lower_length = length_of(local_translations[ankle]);
-        if (!ik.validate() || !finite(target)) continue;
-        const TwoBoneIkResult r = solve_two_bone_ik(ik);
+        ik.upper_length = length_of(pose.local_translations[knee]);
+        ik.lower_length = length_of(pose.local_translations[ankle]);
+        TwoBoneIkResult r;
+        ik.result = &r;
+        if (!ik.run()) continue;  // a degenerate leg (zero length, non-finite target) keeps the clip's pose
         // Turn the clip's thigh and shin onto the solved bones (shortest arcs), so
         // the skeleton's own segment frames and twist are kept.
         const quat turn_upper = quat_from_to(unit_or(k - h, -up), unit_or(r.mid - h, -up));
         const vec3 lower_before = quat_rotate(turn_upper, unit_or(a - k, -up));
         const quat turn_lower = quat_from_to(lower_before, unit_or(r.end - r.mid, -up));
-        const quat hip_world = quat_normalize(quat_mul(turn_upper, model_rotations[hip]));
-        const quat knee_world = quat_normalize(quat_mul(turn_lower, quat_mul(turn_upper, model_rotations[knee])));
+        const quat hip_world = quat_normalize(quat_mul(turn_upper, pose.model_rotations[hip]));
+        const quat knee_world = quat_normalize(quat_mul(turn_lower, quat_mul(turn_upper, pose.model_rotations[knee])));
         // A planted foot lies on the ground's slope; a lifted one keeps the clip's.
         // (The normal under the target, not under the clip's foot: a pinned foot
         // must not tilt because the clip's foot slid over a slope's edge.)
         const vec3 normal = query_ground(*terrain, target.x, target.z).normal;
         const quat tilt = quat_slerp(quat_identity(), quat_from_to(up, normal), smoothstep(pin.plant));
-        const quat foot_world = quat_normalize(quat_mul(tilt, model_rotations[ankle]));
+        const quat foot_world = quat_normalize(quat_mul(tilt, pose.model_rotations[ankle]));
         const int hip_parent = parents[hip];
-        const quat parent_world = hip_parent >= 0 ? model_rotations[static_cast<size_t>(hip_parent)] : quat_identity();
-        local_rotations[hip] = quat_normalize(quat_mul(quat_conjugate(parent_world), hip_world));
-        local_rotations[knee] = quat_normalize(quat_mul(quat_conjugate(hip_world), knee_world));
-        local_rotations[ankle] = quat_normalize(quat_mul(quat_conjugate(knee_world), foot_world));
+        const quat parent_world = hip_parent >= 0 ? pose.model_rotations[static_cast<size_t>(hip_parent)] : quat_identity();
+        pose.local_rotations[hip] = quat_normalize(quat_mul(quat_conjugate(parent_world), hip_world));
+        pose.local_rotations[knee] = quat_normalize(quat_mul(quat_conjugate(hip_world), knee_world));
+        pose.local_rotations[ankle] = quat_normalize(quat_mul(quat_conjugate(knee_world), foot_world));
     }
-    const LocalToModelJob fk{parents, local_rotations, local_translations, model_rotations, model_positions};
-    fk.run();
+    // Cannot fail: validate() checked the sizes and the order FK needs.
+    if (!LocalToModelJob{parents, pose.local(), pose.model()}.run()) return false;
     for (int i = 0; i < 2; ++i)
-        s.feet[static_cast<size_t>(i)].placed = model_positions[static_cast<size_t>(rig->legs[static_cast<size_t>(i)].ankle)];
+        s.feet[static_cast<size_t>(i)].placed = pose.model_positions[static_cast<size_t>(rig->legs[static_cast<size_t>(i)].ankle)];
     s.started = 1;
+    return true;
 }
 
 }  // namespace marionette

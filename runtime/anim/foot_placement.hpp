@@ -12,7 +12,8 @@
 //     kFootLookAheadM ahead of it, so a foot rises onto a step before its toes
 //     reach the riser, not at it;
 //   - a planted foot tilts to the ground's normal.
-// A job in the ozz style: plain state in, spans in and out, no allocation. The
+// A job (runtime/anim/pose_spans.hpp): plain state in and out, spans in and
+// out, no allocation; run() returns false, touching neither, on bad input. The
 // legs are found by joint index (hip = knee's parent, knee = ankle's parent),
 // so it works for any skeleton whose foot joints the graph names; segment
 // lengths are read from the pose's own local translations, so scaled graphs work.
@@ -20,8 +21,9 @@
 #include <cstdint>
 #include <span>
 
-#include "runtime/math/math.hpp"
+#include "runtime/anim/pose_spans.hpp"
 #include "runtime/ground/terrain.hpp"
+#include "runtime/math/math.hpp"
 
 namespace marionette {
 
@@ -77,13 +79,12 @@ struct FootPlacementJob {
     float terrain_rate = 10.0f;    // 1/s
     std::span<const int> parents;
     // In: the clip pose (locals) and its forward kinematics. Out: the placed pose, both.
-    std::span<quat> local_rotations;
-    std::span<vec3> local_translations;
-    std::span<quat> model_rotations;
-    std::span<vec3> model_positions;
+    PoseSpans pose;
 
+    // False without a state, rig or terrain, with an invalid rig, a negative time
+    // or rate, spans not of the skeleton's size, or parents out of order.
     bool validate() const;
-    void run() const;
+    [[nodiscard]] bool run() const;
 };
 
 }  // namespace marionette

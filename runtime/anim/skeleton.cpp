@@ -10,25 +10,25 @@ int Skeleton::find(std::string_view name) const {
     return -1;
 }
 
-std::string validate_skeleton(const Skeleton& s) {
+Outcome validate_skeleton(const Skeleton& s) {
     const size_t n = s.parents.size();
     if (s.joint_names.size() != n || s.rest_offsets.size() != n)
-        return "joint name, parent and offset arrays differ in size";
-    if (n == 0) return "skeleton has no joints";
+        return Outcome::failure("joint name, parent and offset arrays differ in size");
+    if (n == 0) return Outcome::failure("skeleton has no joints");
     std::map<std::string_view, size_t> seen;
     for (size_t i = 0; i < n; ++i) {
         if (s.parents[i] != kNoParent && (s.parents[i] < 0 || static_cast<size_t>(s.parents[i]) >= i))
-            return "joint '" + s.joint_names[i] + "' has parent index " + std::to_string(s.parents[i]) +
-                   ", which is not an earlier joint";
-        if (s.joint_names[i].empty()) return "joint " + std::to_string(i) + " has an empty name";
+            return Outcome::failure("joint '" + s.joint_names[i] + "' has parent index " +
+                                    std::to_string(s.parents[i]) + ", which is not an earlier joint");
+        if (s.joint_names[i].empty()) return Outcome::failure("joint " + std::to_string(i) + " has an empty name");
         auto [it, inserted] = seen.emplace(s.joint_names[i], i);
-        if (!inserted) return "duplicate joint name '" + s.joint_names[i] + "'";
+        if (!inserted) return Outcome::failure("duplicate joint name '" + s.joint_names[i] + "'");
     }
     if (s.end_site_parents.size() != s.end_site_offsets.size())
-        return "end site parent and offset arrays differ in size";
+        return Outcome::failure("end site parent and offset arrays differ in size");
     for (int p : s.end_site_parents)
-        if (p < 0 || static_cast<size_t>(p) >= n) return "end site has an invalid parent index";
-    return {};
+        if (p < 0 || static_cast<size_t>(p) >= n) return Outcome::failure("end site has an invalid parent index");
+    return Outcome::success();
 }
 
 Pose rest_pose(const Skeleton& s) {
@@ -40,29 +40,26 @@ Pose rest_pose(const Skeleton& s) {
 
 bool LocalToModelJob::validate() const {
     const size_t n = parents.size();
-    if (local_rotations.size() != n || local_translations.size() != n ||
-        model_rotations.size() < n || model_positions.size() < n)
-        return false;
-    for (size_t i = 0; i < n; ++i)
-        if (parents[i] != kNoParent && (parents[i] < 0 || static_cast<size_t>(parents[i]) >= i))
-            return false;
-    return true;
+    return input.rotations.size() == n && input.translations.size() == n && output.rotations.size() >= n &&
+           output.positions.size() >= n && parents_in_topological_order(parents);
 }
 
-void LocalToModelJob::run() const {
+bool LocalToModelJob::run() const {
+    if (!validate()) return false;
     const size_t n = parents.size();
     for (size_t i = 0; i < n; ++i) {
         const int p = parents[i];
         if (p == kNoParent) {
-            model_rotations[i] = local_rotations[i];
-            model_positions[i] = local_translations[i];
+            output.rotations[i] = input.rotations[i];
+            output.positions[i] = input.translations[i];
         } else {
-            const quat parent_rotation = model_rotations[static_cast<size_t>(p)];
-            model_rotations[i] = quat_mul(parent_rotation, local_rotations[i]);
-            model_positions[i] =
-                model_positions[static_cast<size_t>(p)] + quat_rotate(parent_rotation, local_translations[i]);
+            const quat parent_rotation = output.rotations[static_cast<size_t>(p)];
+            output.rotations[i] = quat_mul(parent_rotation, input.rotations[i]);
+            output.positions[i] =
+                output.positions[static_cast<size_t>(p)] + quat_rotate(parent_rotation, input.translations[i]);
         }
     }
+    return true;
 }
 
 }  // namespace marionette

@@ -7,11 +7,11 @@
 #include <string_view>
 #include <vector>
 
+#include "runtime/anim/pose_spans.hpp"
+#include "runtime/errors/outcome.hpp"
 #include "runtime/math/math.hpp"
 
 namespace marionette {
-
-inline constexpr int kNoParent = -1;
 
 struct Skeleton {
     std::vector<std::string> joint_names;
@@ -27,9 +27,9 @@ struct Skeleton {
     int find(std::string_view name) const;
 };
 
-// Empty string when the skeleton is well formed, otherwise what is wrong
-// (sizes differ, a parent index not before its child, duplicate or empty names).
-std::string validate_skeleton(const Skeleton& skeleton);
+// Ok when the skeleton is well formed, otherwise what is wrong (sizes differ, a
+// parent index not before its child, duplicate or empty names).
+Outcome validate_skeleton(const Skeleton& skeleton);
 
 // A pose is the local transform of every joint: rotation relative to the parent
 // and translation in the parent's frame (the rest offset, unless the source
@@ -42,17 +42,15 @@ struct Pose {
 Pose rest_pose(const Skeleton& skeleton);
 
 // Forward kinematics: local transforms → model space, one pass in joint order.
-// A job in the ozz sense: spans in, spans out, no allocation. validate() checks
-// the sizes and the topological order; run() assumes they hold.
+// A job (runtime/anim/pose_spans.hpp): validate() checks the sizes (the model
+// spans may be longer than the skeleton) and the topological order.
 struct LocalToModelJob {
     std::span<const int> parents;
-    std::span<const quat> local_rotations;
-    std::span<const vec3> local_translations;
-    std::span<quat> model_rotations;
-    std::span<vec3> model_positions;
+    LocalPoseInput input;
+    ModelPoseOutput output;
 
     bool validate() const;
-    void run() const;
+    [[nodiscard]] bool run() const;
 };
 
 }  // namespace marionette

@@ -18,8 +18,8 @@ vec3 any_perpendicular(vec3 v) {
 }
 }  // namespace
 
-bool TwoBoneIkInput::validate() const {
-    return upper_length > 0.0f && lower_length > 0.0f && std::isfinite(upper_length) && std::isfinite(lower_length) &&
+bool TwoBoneIkJob::validate() const {
+    return result && upper_length > 0.0f && lower_length > 0.0f && std::isfinite(upper_length) && std::isfinite(lower_length) &&
            finite3(root) && finite3(target) && finite3(pole) && soft_reach_start > 0.0f && soft_reach_start <= 1.0f &&
            min_reach_margin >= 0.0f;
 }
@@ -55,7 +55,8 @@ quat quat_from_to(vec3 from, vec3 to) {
     return quat_normalize(quat(1.0f + d, c.x, c.y, c.z));
 }
 
-TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& in) {
+namespace {
+TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkJob& in) {
     TwoBoneIkResult out;
     const float a = in.upper_length;
     const float b = in.lower_length;
@@ -117,6 +118,13 @@ TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& in) {
     const vec3 miss = out.end - in.target;
     out.reached = dot3(miss, miss) <= 1e-8f;
     return out;
+}
+}  // namespace
+
+bool TwoBoneIkJob::run() const {
+    if (!validate()) return false;
+    *result = solve_two_bone_ik(*this);
+    return true;
 }
 
 }  // namespace marionette

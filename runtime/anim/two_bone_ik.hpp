@@ -1,6 +1,7 @@
 #pragma once
-// Analytic two-bone IK (hip–knee–ankle, shoulder–elbow–wrist) as a plain job:
-// inputs in, result out, no allocation, no hidden state. The law of cosines gives
+// Analytic two-bone IK (hip–knee–ankle, shoulder–elbow–wrist) as a job
+// (runtime/anim/pose_spans.hpp): parameters in, result out, no allocation, no
+// hidden state. The law of cosines gives
 // the bend; the rotations come from cross and dot products (half-angle
 // identities), so there is not one trig call and the bits are the same on every
 // platform.
@@ -15,7 +16,17 @@
 
 namespace marionette {
 
-struct TwoBoneIkInput {
+struct TwoBoneIkResult {
+    vec3 mid{0.0f};                      // knee / elbow, world
+    vec3 end{0.0f};                      // where the end joint actually is
+    vec3 hinge_axis{1.0f, 0.0f, 0.0f};   // unit, shared by both segment frames
+    quat upper_rotation{1.0f, 0.0f, 0.0f, 0.0f};  // world frame of the upper segment
+    quat lower_rotation{1.0f, 0.0f, 0.0f, 0.0f};  // world frame of the lower segment
+    float reach = 0.0f;                  // distance root → end after softening and clamping
+    bool reached = false;                // end == target (within 0.1 mm)
+};
+
+struct TwoBoneIkJob {
     vec3 root{0.0f};                    // hip / shoulder, world
     vec3 target{0.0f};                  // where the end joint (ankle / wrist) should go
     vec3 pole{0.0f, 0.0f, 1.0f};        // direction the mid joint should point (knees forward, elbows back)
@@ -28,22 +39,13 @@ struct TwoBoneIkInput {
     // (upper + lower), so a fully folded limb still has a defined bend.
     float min_reach_margin = 1e-4f;
     float hinge_sign = 1.0f;            // +1: frame +Z toward the pole; −1: away from it
+    TwoBoneIkResult* result = nullptr;  // out
 
-    // False when a length is not positive or a value is not finite.
+    // False when there is no result to write, a length is not positive or a
+    // value is not finite.
     bool validate() const;
+    [[nodiscard]] bool run() const;
 };
-
-struct TwoBoneIkResult {
-    vec3 mid{0.0f};                      // knee / elbow, world
-    vec3 end{0.0f};                      // where the end joint actually is
-    vec3 hinge_axis{1.0f, 0.0f, 0.0f};   // unit, shared by both segment frames
-    quat upper_rotation{1.0f, 0.0f, 0.0f, 0.0f};  // world frame of the upper segment
-    quat lower_rotation{1.0f, 0.0f, 0.0f, 0.0f};  // world frame of the lower segment
-    float reach = 0.0f;                  // distance root → end after softening and clamping
-    bool reached = false;                // end == target (within 0.1 mm)
-};
-
-TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& input);
 
 // Rotation whose columns are the given orthonormal axes (right-handed), via
 // Shepperd's method: sqrt only.

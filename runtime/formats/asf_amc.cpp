@@ -45,8 +45,6 @@
 
 #include <algorithm>
 #include <array>
-#include <charconv>
-#include <climits>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -54,6 +52,8 @@
 #include <utility>
 #include <vector>
 
+#include "runtime/formats/file_names.hpp"
+#include "runtime/formats/text_lexer.hpp"
 #include "runtime/formats/text_number.hpp"
 
 namespace marionette {
@@ -74,149 +74,34 @@ struct AsfSkeleton {
 
 namespace {
 
+using namespace text;
+
 constexpr int kMaxBones = 1023;  // plus the root: the BVH importer's 1024 joints
 constexpr std::int64_t kMaxPoseSamples = std::int64_t{1} << 24;
-constexpr std::size_t kMaxQuotedChars = 40;
-constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{512} << 20;
 // Shorter directions carry no usable orientation.
 constexpr double kMinDirectionNorm = 1.0e-12;
 
 constexpr std::uint8_t kRotateX = 3;
 
-// ---------------------------------------------------------------- text
-
-bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; }
-bool is_line_end(char c) { return c == '\n' || c == '\r'; }
-
-char ascii_lower(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; }
-
-// Keywords are matched without regard to case (`:DEGREES`, `Begin`): nothing
-// is lost by it and some writers vary.
-bool iequals(std::string_view a, std::string_view b) {
-    if (a.size() != b.size()) return false;
-    for (std::size_t i = 0; i < a.size(); ++i)
-        if (ascii_lower(a[i]) != ascii_lower(b[i])) return false;
-    return true;
-}
-
-std::string_view trim_blanks(std::string_view s) {
-    while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
-    while (!s.empty() && is_blank(s.back())) s.remove_suffix(1);
-    return s;
-}
-
-std::string quoted(std::string_view token) {
-    if (token.size() > kMaxQuotedChars) return "'" + std::string(token.substr(0, kMaxQuotedChars)) + "...'";
-    return "'" + std::string(token) + "'";
-}
-
-void split_blanks(std::string_view line, std::vector<std::string_view>& out) {
-    out.clear();
-    std::size_t pos = 0;
-    while (pos < line.size()) {
-        while (pos < line.size() && is_blank(line[pos])) ++pos;
-        if (pos == line.size()) break;
-        const std::size_t start = pos;
-        while (pos < line.size() && !is_blank(line[pos])) ++pos;
-        out.push_back(line.substr(start, pos - start));
-    }
-}
-
-struct Line {
-    std::string_view text;  // comment removed, blanks trimmed, never empty
-    int number = 0;
-};
-
-// Lines with content, one at a time. "\r\n", "\n" and a lone "\r" each end a
-// line; '#' starts a comment that runs to the end of the line.
-class LineReader {
-public:
-    LineReader(std::string_view text, const std::string& file) : text_(text), file_(file) {
-        if (text_.substr(0, 3) == "\xEF\xBB\xBF") pos_ = 3;
-    }
-
-    [[noreturn]] void fail(int line, const std::string& message) const { throw ImportError(file_, line, message); }
-
-    // Where "found end of file" is reported: the last line with content.
-    int end_line() const { return last_content_line_; }
-
-    void reject_control_bytes(const char* kind) const {
-        int line = 1;
-        for (std::size_t i = 0; i < text_.size(); ++i) {
-            const auto c = static_cast<unsigned char>(text_[i]);
-            if (c == '\n' || (c == '\r' && (i + 1 == text_.size() || text_[i + 1] != '\n'))) {
-                if (line < INT_MAX) ++line;
-            } else if ((c < 0x20 && !is_blank(static_cast<char>(c)) && c != '\r') || c == 0x7F) {
-                static constexpr char kHex[] = "0123456789ABCDEF";
-                std::string byte = "0x";
-                byte += kHex[c >> 4];
-                byte += kHex[c & 15];
-                fail(line, "unexpected control byte " + byte + " (expected " + kind + " text; is this a binary file?)");
-            }
-        }
-    }
-
-    bool next(Line& out) {
-        while (pos_ < text_.size()) {
-            const std::size_t start = pos_;
-            while (pos_ < text_.size() && !is_line_end(text_[pos_])) ++pos_;
-            std::string_view raw = text_.substr(start, pos_ - start);
-            const int number = line_;
-            if (pos_ < text_.size()) {
-                if (text_[pos_] == '\r' && pos_ + 1 < text_.size() && text_[pos_ + 1] == '\n') ++pos_;
-                ++pos_;
-                if (line_ < INT_MAX) ++line_;
-            }
-            if (const std::size_t hash = raw.find('#'); hash != std::string_view::npos) raw = raw.substr(0, hash);
-            raw = trim_blanks(raw);
-            if (raw.empty()) continue;
-            out.text = raw;
-            out.number = number;
-            last_content_line_ = number;
-            return true;
-        }
-        return false;
-    }
-
-    bool peek(Line& out) {
-        const std::size_t pos = pos_;
-        const int line = line_;
-        const int last = last_content_line_;
-        const bool have = next(out);
-        pos_ = pos;
-        line_ = line;
-        last_content_line_ = last;
-        return have;
-    }
-
-private:
-    std::string_view text_;
-    const std::string& file_;
-    std::size_t pos_ = 0;
-    int line_ = 1;
-    int last_content_line_ = 1;
-};
-
 // ---------------------------------------------------------------- numbers
 
-
-double read_number(const LineReader& reader, int line, std::string_view token, const std::string& what) {
+double read_number(const TextLexer& reader, int line, std::string_view token, const std::string& what) {
     double value = 0.0;
     switch (parse_real(token, value)) {
         case NumberStatus::ok:
             return value;
         case NumberStatus::too_large:
-            reader.fail(line, what + " is out of range: " + quoted(token) + " (expected a magnitude up to 1e9)");
+            reader.fail(line, what + " is out of range: " + quote_token(token) + " (expected a magnitude up to 1e9)");
         default:
-            reader.fail(line, "expected a finite number for " + what + ", found " + quoted(token));
+            reader.fail(line, "expected a finite number for " + what + ", found " + quote_token(token));
     }
 }
 
 // The numbers after a keyword, all on its line.
-std::array<double, 3> read_three(const LineReader& reader, const Line& line,
+std::array<double, 3> read_three(const TextLexer& reader, const Line& line,
                                  const std::vector<std::string_view>& tokens, const std::string& what) {
     if (tokens.size() != 4)
-        reader.fail(line.number, quoted(tokens[0]) + " needs 3 numbers (" + what + "), found " +
+        reader.fail(line.number, quote_token(tokens[0]) + " needs 3 numbers (" + what + "), found " +
                                      std::to_string(tokens.size() - 1));
     std::array<double, 3> out{};
     for (std::size_t i = 0; i < 3; ++i) out[i] = read_number(reader, line.number, tokens[i + 1], what);
@@ -300,16 +185,16 @@ struct AsfFile {
 
 bool is_section_line(const Line& line) { return line.text.front() == ':'; }
 
-void read_units(LineReader& reader, AsfFile& asf, std::vector<std::string_view>& tokens) {
+void read_units(TextLexer& reader, AsfFile& asf, std::vector<std::string_view>& tokens) {
     Line line;
-    while (reader.peek(line) && !is_section_line(line)) {
-        reader.next(line);
+    while (reader.peek_content_line(line) && !is_section_line(line)) {
+        reader.next_content_line(line);
         split_blanks(line.text, tokens);
         if (tokens.size() != 2)
-            reader.fail(line.number, "expected 'KEY VALUE' in :units (mass, length or angle), found " + quoted(line.text));
+            reader.fail(line.number, "expected 'KEY VALUE' in :units (mass, length or angle), found " + quote_token(line.text));
         if (iequals(tokens[0], "length")) {
             const double v = read_number(reader, line.number, tokens[1], "the length unit");
-            if (!(v > 0.0)) reader.fail(line.number, "the length unit must be positive, found " + quoted(tokens[1]));
+            if (!(v > 0.0)) reader.fail(line.number, "the length unit must be positive, found " + quote_token(tokens[1]));
             asf.length_unit = v;
         } else if (iequals(tokens[0], "angle")) {
             const std::string_view u = tokens[1];
@@ -318,7 +203,7 @@ void read_units(LineReader& reader, AsfFile& asf, std::vector<std::string_view>&
             } else if (iequals(u, "rad") || iequals(u, "radian") || iequals(u, "radians")) {
                 asf.degrees = false;
             } else {
-                reader.fail(line.number, "expected 'deg' or 'rad' for the angle unit, found " + quoted(u));
+                reader.fail(line.number, "expected 'deg' or 'rad' for the angle unit, found " + quote_token(u));
             }
         } else if (iequals(tokens[0], "mass")) {
             read_number(reader, line.number, tokens[1], "the mass unit");  // checked, not used
@@ -327,21 +212,21 @@ void read_units(LineReader& reader, AsfFile& asf, std::vector<std::string_view>&
     }
 }
 
-void skip_section_body(LineReader& reader) {
+void skip_section_body(TextLexer& reader) {
     Line line;
-    while (reader.peek(line) && !is_section_line(line)) reader.next(line);
+    while (reader.peek_content_line(line) && !is_section_line(line)) reader.next_content_line(line);
 }
 
-void read_root(LineReader& reader, AsfFile& asf, std::vector<std::string_view>& tokens) {
+void read_root(TextLexer& reader, AsfFile& asf, std::vector<std::string_view>& tokens) {
     RootDef& root = asf.root;
     Line line;
-    while (reader.peek(line) && !is_section_line(line)) {
-        reader.next(line);
+    while (reader.peek_content_line(line) && !is_section_line(line)) {
+        reader.next_content_line(line);
         split_blanks(line.text, tokens);
         const std::string_view key = tokens[0];
         auto once = [&](int& seen) {
             if (seen)
-                reader.fail(line.number, ":root has a second " + quoted(key) + " (first on line " +
+                reader.fail(line.number, ":root has a second " + quote_token(key) + " (first on line " +
                                              std::to_string(seen) + ")");
             seen = line.number;
         };
@@ -354,18 +239,18 @@ void read_root(LineReader& reader, AsfFile& asf, std::vector<std::string_view>& 
                 const std::string_view t = tokens[i];
                 if (t.size() != 2 || (ascii_lower(t[0]) != 't' && ascii_lower(t[0]) != 'r') ||
                     ascii_lower(t[1]) < 'x' || ascii_lower(t[1]) > 'z')
-                    reader.fail(line.number, "expected a root channel (TX, TY, TZ, RX, RY or RZ), found " + quoted(t));
+                    reader.fail(line.number, "expected a root channel (TX, TY, TZ, RX, RY or RZ), found " + quote_token(t));
                 const auto code = static_cast<std::uint8_t>((ascii_lower(t[0]) == 'r' ? 3 : 0) + (ascii_lower(t[1]) - 'x'));
                 for (int c = 0; c < root.dofs.count; ++c)
                     if (root.dofs.channels[static_cast<std::size_t>(c)] == code)
-                        reader.fail(line.number, "root channel " + quoted(t) + " is listed twice in 'order'");
+                        reader.fail(line.number, "root channel " + quote_token(t) + " is listed twice in 'order'");
                 root.dofs.channels[static_cast<std::size_t>(root.dofs.count++)] = code;
             }
         } else if (iequals(key, "axis")) {
             once(root.axis_line);
             if (tokens.size() != 2 || !parse_axis_order(tokens[1], root.axis_order))
                 reader.fail(line.number, "expected an axis order such as XYZ after 'axis' in :root, found " +
-                                             quoted(trim_blanks(line.text.substr(4))));
+                                             quote_token(trim_blanks(line.text.substr(4))));
         } else if (iequals(key, "position")) {
             once(root.position_line);
             root.position = read_three(reader, line, tokens, "root position");
@@ -373,7 +258,7 @@ void read_root(LineReader& reader, AsfFile& asf, std::vector<std::string_view>& 
             once(root.orientation_line);
             root.orientation = read_three(reader, line, tokens, "root orientation");
         } else {
-            reader.fail(line.number, "expected order, axis, position or orientation in :root, found " + quoted(key));
+            reader.fail(line.number, "expected order, axis, position or orientation in :root, found " + quote_token(key));
         }
     }
     const std::pair<int, const char*> required[] = {{root.order_line, "order"},
@@ -386,7 +271,7 @@ void read_root(LineReader& reader, AsfFile& asf, std::vector<std::string_view>& 
 
 // "(lo hi)" pairs; parentheses may touch the numbers or not. Infinite limits
 // are part of the format ("(-inf inf)"), so they are accepted here only.
-void read_limit_pairs(const LineReader& reader, int line_no, std::string_view text, BoneDef& bone) {
+void read_limit_pairs(const TextLexer& reader, int line_no, std::string_view text, BoneDef& bone) {
     std::size_t pos = 0;
     auto skip = [&] {
         while (pos < text.size() && is_blank(text[pos])) ++pos;
@@ -398,7 +283,7 @@ void read_limit_pairs(const LineReader& reader, int line_no, std::string_view te
         const std::string_view token = text.substr(start, pos - start);
         if (token.empty())
             reader.fail(line_no, std::string("expected the ") + which + " limit in '(lo hi)', found " +
-                                     (pos < text.size() ? quoted(text.substr(pos, 1)) : "end of line"));
+                                     (pos < text.size() ? quote_token(text.substr(pos, 1)) : "end of line"));
         std::string_view body = token;
         if (!body.empty() && (body.front() == '-' || body.front() == '+')) body.remove_prefix(1);
         if (iequals(body, "inf") || iequals(body, "infinity")) return;
@@ -408,43 +293,43 @@ void read_limit_pairs(const LineReader& reader, int line_no, std::string_view te
         skip();
         if (pos == text.size()) return;
         if (text[pos] != '(')
-            reader.fail(line_no, "expected '(' to start a limit pair '(lo hi)', found " + quoted(text.substr(pos)));
+            reader.fail(line_no, "expected '(' to start a limit pair '(lo hi)', found " + quote_token(text.substr(pos)));
         ++pos;
         number("lower");
         number("upper");
         skip();
         if (pos == text.size() || text[pos] != ')')
             reader.fail(line_no, "expected ')' to close a limit pair '(lo hi)', found " +
-                                     (pos < text.size() ? quoted(text.substr(pos)) : std::string("end of line")));
+                                     (pos < text.size() ? quote_token(text.substr(pos)) : std::string("end of line")));
         ++pos;
         ++bone.limit_pairs;
     }
 }
 
-void read_dofs(const LineReader& reader, const Line& line, const std::vector<std::string_view>& tokens, BoneDef& bone) {
+void read_dofs(const TextLexer& reader, const Line& line, const std::vector<std::string_view>& tokens, BoneDef& bone) {
     if (tokens.size() < 2) reader.fail(line.number, "expected rx, ry or rz after 'dof'");
     for (std::size_t i = 1; i < tokens.size(); ++i) {
         const std::string_view t = tokens[i];
         if (iequals(t, "tx") || iequals(t, "ty") || iequals(t, "tz") || iequals(t, "l"))
-            reader.fail(line.number, "dof " + quoted(t) + " is not supported (expected rx, ry or rz; only the root "
+            reader.fail(line.number, "dof " + quote_token(t) + " is not supported (expected rx, ry or rz; only the root "
                                      "translates)");
         if (t.size() != 2 || ascii_lower(t[0]) != 'r' || ascii_lower(t[1]) < 'x' || ascii_lower(t[1]) > 'z')
-            reader.fail(line.number, "expected a dof (rx, ry or rz), found " + quoted(t));
+            reader.fail(line.number, "expected a dof (rx, ry or rz), found " + quote_token(t));
         const auto code = static_cast<std::uint8_t>(kRotateX + (ascii_lower(t[1]) - 'x'));
         for (int c = 0; c < bone.dofs.count; ++c)
             if (bone.dofs.channels[static_cast<std::size_t>(c)] == code)
-                reader.fail(line.number, "dof " + quoted(t) + " is listed twice");
+                reader.fail(line.number, "dof " + quote_token(t) + " is listed twice");
         if (bone.dofs.count == 3) reader.fail(line.number, "more than 3 dofs");
         bone.dofs.channels[static_cast<std::size_t>(bone.dofs.count++)] = code;
     }
 }
 
-void read_bone(LineReader& reader, BoneDef& bone, std::vector<std::string_view>& tokens) {
+void read_bone(TextLexer& reader, BoneDef& bone, std::vector<std::string_view>& tokens) {
     const std::string closing = "expected 'end' to close the bone block opened on line " + std::to_string(bone.begin_line);
     bool last_was_limits = false;
     Line line;
     for (;;) {
-        if (!reader.next(line)) reader.fail(reader.end_line(), closing + ", found end of file");
+        if (!reader.next_content_line(line)) reader.fail(reader.end_line(), closing + ", found end of file");
         if (line.text.front() == '(') {
             if (!last_was_limits)
                 reader.fail(line.number, "a line starting with '(' must continue 'limits' (expected a bone keyword)");
@@ -456,21 +341,21 @@ void read_bone(LineReader& reader, BoneDef& bone, std::vector<std::string_view>&
         const std::string_view key = tokens[0];
         auto once = [&](int& seen) {
             if (seen)
-                reader.fail(line.number, "the bone block has a second " + quoted(key) + " (first on line " +
+                reader.fail(line.number, "the bone block has a second " + quote_token(key) + " (first on line " +
                                              std::to_string(seen) + ")");
             seen = line.number;
         };
         if (iequals(key, "end")) {
-            if (tokens.size() != 1) reader.fail(line.number, "expected nothing after 'end', found " + quoted(tokens[1]));
+            if (tokens.size() != 1) reader.fail(line.number, "expected nothing after 'end', found " + quote_token(tokens[1]));
             break;
         }
-        if (is_section_line(line) || iequals(key, "begin")) reader.fail(line.number, closing + ", found " + quoted(key));
+        if (is_section_line(line) || iequals(key, "begin")) reader.fail(line.number, closing + ", found " + quote_token(key));
         if (iequals(key, "id")) {
             std::int64_t id = 0;
             if (bone.has_id) reader.fail(line.number, "the bone block has a second 'id'");
             if (tokens.size() != 2 || !parse_integer(tokens[1], id))
                 reader.fail(line.number, "expected a whole number after 'id', found " +
-                                             quoted(trim_blanks(line.text.substr(2))));
+                                             quote_token(trim_blanks(line.text.substr(2))));
             bone.has_id = true;
         } else if (iequals(key, "name")) {
             once(bone.name_line);
@@ -485,7 +370,7 @@ void read_bone(LineReader& reader, BoneDef& bone, std::vector<std::string_view>&
             if (tokens.size() != 2)
                 reader.fail(line.number, "'length' needs 1 number, found " + std::to_string(tokens.size() - 1));
             bone.length = read_number(reader, line.number, tokens[1], "bone length");
-            if (bone.length < 0.0) reader.fail(line.number, "bone length must not be negative, found " + quoted(tokens[1]));
+            if (bone.length < 0.0) reader.fail(line.number, "bone length must not be negative, found " + quote_token(tokens[1]));
         } else if (iequals(key, "axis")) {
             once(bone.axis_line);
             if (tokens.size() != 4 && tokens.size() != 5)
@@ -493,7 +378,7 @@ void read_bone(LineReader& reader, BoneDef& bone, std::vector<std::string_view>&
                                              std::to_string(tokens.size() - 1) + " values");
             for (std::size_t i = 0; i < 3; ++i) bone.axis[i] = read_number(reader, line.number, tokens[i + 1], "axis angle");
             if (tokens.size() == 5 && !parse_axis_order(tokens[4], bone.axis_order))
-                reader.fail(line.number, "expected an axis order such as XYZ, found " + quoted(tokens[4]));
+                reader.fail(line.number, "expected an axis order such as XYZ, found " + quote_token(tokens[4]));
         } else if (iequals(key, "dof")) {
             once(bone.dof_line);
             read_dofs(reader, line, tokens, bone);
@@ -505,7 +390,7 @@ void read_bone(LineReader& reader, BoneDef& bone, std::vector<std::string_view>&
             for (std::size_t i = 1; i < tokens.size(); ++i) read_number(reader, line.number, tokens[i], std::string(key));
         } else {
             reader.fail(line.number, "expected id, name, direction, length, axis, dof, limits or end in the bone block "
-                                     "opened on line " + std::to_string(bone.begin_line) + ", found " + quoted(key));
+                                     "opened on line " + std::to_string(bone.begin_line) + ", found " + quote_token(key));
         }
     }
     const std::pair<int, const char*> required[] = {
@@ -515,17 +400,17 @@ void read_bone(LineReader& reader, BoneDef& bone, std::vector<std::string_view>&
             reader.fail(line.number, "the bone block opened on line " + std::to_string(bone.begin_line) + " lacks '" +
                                          name + "'");
     if (bone.limits_line && bone.limit_pairs != bone.dofs.count)
-        reader.fail(bone.limits_line, "bone " + quoted(bone.name) + " has " + std::to_string(bone.dofs.count) +
+        reader.fail(bone.limits_line, "bone " + quote_token(bone.name) + " has " + std::to_string(bone.dofs.count) +
                                           " dofs but " + std::to_string(bone.limit_pairs) +
                                           " limit pairs (expected one '(lo hi)' per dof)");
 }
 
-void read_bonedata(LineReader& reader, AsfFile& asf, std::vector<std::string_view>& tokens) {
+void read_bonedata(TextLexer& reader, AsfFile& asf, std::vector<std::string_view>& tokens) {
     Line line;
-    while (reader.peek(line) && !is_section_line(line)) {
-        reader.next(line);
+    while (reader.peek_content_line(line) && !is_section_line(line)) {
+        reader.next_content_line(line);
         if (!iequals(line.text, "begin"))
-            reader.fail(line.number, "expected 'begin' to start a bone block in :bonedata, found " + quoted(line.text));
+            reader.fail(line.number, "expected 'begin' to start a bone block in :bonedata, found " + quote_token(line.text));
         if (static_cast<int>(asf.bones.size()) >= kMaxBones)
             reader.fail(line.number, "too many bones: more than " + std::to_string(kMaxBones) + " (the limit)");
         BoneDef bone;
@@ -535,25 +420,26 @@ void read_bonedata(LineReader& reader, AsfFile& asf, std::vector<std::string_vie
     }
 }
 
-void read_hierarchy(LineReader& reader, AsfFile& asf, std::vector<std::string_view>& tokens) {
+void read_hierarchy(TextLexer& reader, AsfFile& asf, std::vector<std::string_view>& tokens) {
     Line line;
-    if (!reader.next(line)) reader.fail(reader.end_line(), "expected 'begin' after :hierarchy, found end of file");
+    if (!reader.next_content_line(line)) reader.fail(reader.end_line(), "expected 'begin' after :hierarchy, found end of file");
     if (!iequals(line.text, "begin"))
-        reader.fail(line.number, "expected 'begin' after :hierarchy, found " + quoted(line.text));
+        reader.fail(line.number, "expected 'begin' after :hierarchy, found " + quote_token(line.text));
     const int begin_line = line.number;
     for (;;) {
         const std::string closing = "expected 'end' to close the :hierarchy block opened on line " + std::to_string(begin_line);
-        if (!reader.next(line)) reader.fail(reader.end_line(), closing + ", found end of file");
+        if (!reader.next_content_line(line)) reader.fail(reader.end_line(), closing + ", found end of file");
         if (iequals(line.text, "end")) return;
-        if (is_section_line(line) || iequals(line.text, "begin")) reader.fail(line.number, closing + ", found " + quoted(line.text));
+        if (is_section_line(line) || iequals(line.text, "begin")) reader.fail(line.number, closing + ", found " + quote_token(line.text));
         split_blanks(line.text, tokens);
         asf.hierarchy.push_back(HierarchyLine{line.number, tokens});
     }
 }
 
 AsfFile read_asf_file(std::string_view text, const std::string& file) {
-    LineReader reader(text, file);
+    TextLexer reader(text, file);
     reader.reject_control_bytes("ASF");
+    reader.skip_utf8_bom();
     AsfFile asf;
     std::vector<std::string_view> tokens;
     struct Section {
@@ -563,12 +449,12 @@ AsfFile read_asf_file(std::string_view text, const std::string& file) {
     std::array<Section, 7> sections = {{{":version", 0}, {":name", 0}, {":units", 0}, {":documentation", 0},
                                         {":root", 0}, {":bonedata", 0}, {":hierarchy", 0}}};
     Line line;
-    while (reader.next(line)) {
+    while (reader.next_content_line(line)) {
         split_blanks(line.text, tokens);
         const std::string_view key = tokens[0];
         if (!is_section_line(line))
             reader.fail(line.number, "expected an ASF section keyword (':version', ':name', ':units', ':documentation', "
-                                     "':root', ':bonedata' or ':hierarchy'), found " + quoted(key));
+                                     "':root', ':bonedata' or ':hierarchy'), found " + quote_token(key));
         Section* section = nullptr;
         for (Section& s : sections)
             if (iequals(key, s.name)) section = &s;
@@ -584,7 +470,7 @@ AsfFile read_asf_file(std::string_view text, const std::string& file) {
         if (name == ":units" || name == ":root" || name == ":bonedata" || name == ":hierarchy") {
             if (tokens.size() > 1)
                 reader.fail(line.number, "expected nothing after " + std::string(name) + " on its line, found " +
-                                             quoted(tokens[1]));
+                                             quote_token(tokens[1]));
         }
         if (name == ":units") {
             read_units(reader, asf, tokens);
@@ -608,31 +494,37 @@ AsfFile read_asf_file(std::string_view text, const std::string& file) {
     return asf;
 }
 
-// Bone names → the skeleton: parents from :hierarchy, then a depth-first walk
-// from the root (explicit stack) for a topological joint order.
-AsfSkeleton build_skeleton(const AsfFile& asf, std::string_view text, const std::string& file) {
-    const LineReader reader(text, file);  // for fail() only
-    const auto bones = static_cast<int>(asf.bones.size());
+// Node n of the bone tree: 0 is the root, 1 + b is bone b.
+std::unordered_map<std::string_view, int> bones_by_name(const AsfFile& asf, const TextLexer& reader) {
     std::unordered_map<std::string_view, int> by_name;
-    for (int b = 0; b < bones; ++b) {
+    for (int b = 0; b < static_cast<int>(asf.bones.size()); ++b) {
         const BoneDef& bone = asf.bones[static_cast<std::size_t>(b)];
         if (bone.name == "root")
             reader.fail(bone.name_line, "a bone cannot be named 'root' (the name is the root's)");
         const auto [it, inserted] = by_name.emplace(bone.name, b);
         if (!inserted)
-            reader.fail(bone.name_line, "duplicate bone name " + quoted(bone.name) + " (first defined on line " +
+            reader.fail(bone.name_line, "duplicate bone name " + quote_token(bone.name) + " (first defined on line " +
                                             std::to_string(asf.bones[static_cast<std::size_t>(it->second)].name_line) + ")");
     }
-    // Node n: 0 is the root, 1 + b is bone b.
-    const auto nodes = static_cast<std::size_t>(bones) + 1;
-    std::vector<int> parent(nodes, -1);
-    std::vector<int> parent_line(nodes, 0);
-    std::vector<std::vector<int>> children(nodes);
+    return by_name;
+}
+
+struct BoneTree {
+    std::vector<int> parent;       // per node; -1 for the root and unattached bones
+    std::vector<int> parent_line;  // the :hierarchy line that gave the parent; 0 for none
+    std::vector<std::vector<int>> children;
+};
+
+// Parents and children from the :hierarchy lines.
+BoneTree link_hierarchy(const AsfFile& asf, const TextLexer& reader) {
+    const std::unordered_map<std::string_view, int> by_name = bones_by_name(asf, reader);
+    const std::size_t nodes = asf.bones.size() + 1;
+    BoneTree tree{std::vector<int>(nodes, -1), std::vector<int>(nodes, 0), std::vector<std::vector<int>>(nodes)};
     auto node_of = [&](std::string_view name, int line) {
         if (name == "root") return 0;
         const auto it = by_name.find(name);
         if (it == by_name.end())
-            reader.fail(line, "unknown bone " + quoted(name) + " in :hierarchy (expected 'root' or a bone from :bonedata)");
+            reader.fail(line, "unknown bone " + quote_token(name) + " in :hierarchy (expected 'root' or a bone from :bonedata)");
         return it->second + 1;
     };
     for (const HierarchyLine& h : asf.hierarchy) {
@@ -640,31 +532,41 @@ AsfSkeleton build_skeleton(const AsfFile& asf, std::string_view text, const std:
         for (std::size_t i = 1; i < h.names.size(); ++i) {
             const int c = node_of(h.names[i], h.line);
             if (c == 0) reader.fail(h.line, "the root cannot be a child in :hierarchy");
-            if (c == p) reader.fail(h.line, "bone " + quoted(h.names[i]) + " cannot be its own parent");
+            if (c == p) reader.fail(h.line, "bone " + quote_token(h.names[i]) + " cannot be its own parent");
             const auto cu = static_cast<std::size_t>(c);
-            if (parent_line[cu])
-                reader.fail(h.line, "bone " + quoted(h.names[i]) + " already has a parent (line " +
-                                        std::to_string(parent_line[cu]) + ")");
-            parent[cu] = p;
-            parent_line[cu] = h.line;
-            children[static_cast<std::size_t>(p)].push_back(c);
+            if (tree.parent_line[cu])
+                reader.fail(h.line, "bone " + quote_token(h.names[i]) + " already has a parent (line " +
+                                        std::to_string(tree.parent_line[cu]) + ")");
+            tree.parent[cu] = p;
+            tree.parent_line[cu] = h.line;
+            tree.children[static_cast<std::size_t>(p)].push_back(c);
         }
     }
+    return tree;
+}
 
-    std::vector<int> joint_of(nodes, -1);
-    std::vector<int> order;  // nodes in joint order
-    order.reserve(nodes);
+struct JointOrder {
+    std::vector<int> joint_of;  // per node; -1 for a node the walk did not reach
+    std::vector<int> nodes;     // nodes in joint order
+};
+
+// A depth-first walk from the root with an explicit stack: a topological joint
+// order, children in the order :hierarchy lists them.
+JointOrder depth_first_order(const BoneTree& tree) {
+    const std::size_t nodes = tree.children.size();
+    JointOrder out{std::vector<int>(nodes, -1), {}};
+    out.nodes.reserve(nodes);
     struct Visit {
         int node;
         std::size_t next_child;
     };
     std::vector<Visit> stack;
-    joint_of[0] = 0;
-    order.push_back(0);
+    out.joint_of[0] = 0;
+    out.nodes.push_back(0);
     stack.push_back({0, 0});
     while (!stack.empty()) {
         Visit& top = stack.back();
-        const auto& kids = children[static_cast<std::size_t>(top.node)];
+        const auto& kids = tree.children[static_cast<std::size_t>(top.node)];
         if (top.next_child == kids.size()) {
             stack.pop_back();
             continue;
@@ -672,38 +574,57 @@ AsfSkeleton build_skeleton(const AsfFile& asf, std::string_view text, const std:
         const int child = kids[top.next_child++];
         // Every node has at most one parent and the root none, so no node is
         // reached twice and the walk ends.
-        joint_of[static_cast<std::size_t>(child)] = static_cast<int>(order.size());
-        order.push_back(child);
+        out.joint_of[static_cast<std::size_t>(child)] = static_cast<int>(out.nodes.size());
+        out.nodes.push_back(child);
         stack.push_back({child, 0});  // may reallocate: `top` is dead from here
     }
-    for (int b = 0; b < bones; ++b) {
-        const auto n = static_cast<std::size_t>(b) + 1;
-        if (joint_of[n] >= 0) continue;
-        const BoneDef& bone = asf.bones[static_cast<std::size_t>(b)];
-        if (!parent_line[n])
-            reader.fail(bone.name_line, "bone " + quoted(bone.name) +
+    return out;
+}
+
+void check_all_reachable(const AsfFile& asf, const BoneTree& tree, const JointOrder& order, const TextLexer& reader) {
+    for (std::size_t b = 0; b < asf.bones.size(); ++b) {
+        const std::size_t n = b + 1;
+        if (order.joint_of[n] >= 0) continue;
+        const BoneDef& bone = asf.bones[b];
+        if (!tree.parent_line[n])
+            reader.fail(bone.name_line, "bone " + quote_token(bone.name) +
                                             " is not attached: no :hierarchy line names it as a child (expected "
                                             "every bone to be reachable from root)");
-        reader.fail(parent_line[n], "bone " + quoted(bone.name) + " is not reachable from root: its parents form a cycle");
+        reader.fail(tree.parent_line[n], "bone " + quote_token(bone.name) + " is not reachable from root: its parents form a cycle");
     }
+}
 
-    // Unit directions (see the decisions at the top); node 0 has no bone.
-    const double angle_scale = asf.degrees ? det::kDegToRad : 1.0;
-    std::vector<vec3> bone_vector(nodes, vec3(0.0f));
-    for (int b = 0; b < bones; ++b) {
-        const BoneDef& bone = asf.bones[static_cast<std::size_t>(b)];
+// Each node's bone as direction · length with a unit direction (see the
+// decisions at the top); node 0 has no bone.
+std::vector<vec3> bone_vectors(const AsfFile& asf, const TextLexer& reader) {
+    std::vector<vec3> bone_vector(asf.bones.size() + 1, vec3(0.0f));
+    for (std::size_t b = 0; b < asf.bones.size(); ++b) {
+        const BoneDef& bone = asf.bones[b];
         const auto& d = bone.direction;
         const double norm = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
         if (!(norm >= kMinDirectionNorm)) {
             if (bone.length != 0.0)
-                reader.fail(bone.direction_line, "bone " + quoted(bone.name) + " has a zero direction (expected a unit vector)");
+                reader.fail(bone.direction_line, "bone " + quote_token(bone.name) + " has a zero direction (expected a unit vector)");
             continue;
         }
         const double scale = bone.length / norm;
-        bone_vector[static_cast<std::size_t>(b) + 1] =
+        bone_vector[b + 1] =
             vec3(static_cast<float>(d[0] * scale), static_cast<float>(d[1] * scale), static_cast<float>(d[2] * scale));
     }
+    return bone_vector;
+}
 
+// C: the axis frame from its three angles in the file's unit.
+quat axis_frame(const std::array<double, 3>& angles, const std::array<int, 3>& order, double angle_scale) {
+    const std::array<double, 3> radians = {angles[0] * angle_scale, angles[1] * angle_scale, angles[2] * angle_scale};
+    return euler_rotation(radians, order);
+}
+
+// The joints in `order`, each with its parent joint, rest offset and dofs.
+AsfSkeleton assemble_skeleton(const AsfFile& asf, const BoneTree& tree, const JointOrder& order,
+                              const std::vector<vec3>& bone_vector) {
+    const double angle_scale = asf.degrees ? det::kDegToRad : 1.0;
+    const std::size_t nodes = tree.children.size();
     AsfSkeleton out;
     out.length_unit = asf.length_unit;
     out.degrees = asf.degrees;
@@ -712,7 +633,7 @@ AsfSkeleton build_skeleton(const AsfFile& asf, std::string_view text, const std:
     sk.parents.reserve(nodes);
     sk.rest_offsets.reserve(nodes);
     out.dofs.reserve(nodes);
-    for (int node : order) {
+    for (int node : order.nodes) {
         const auto n = static_cast<std::size_t>(node);
         if (node == 0) {
             const RootDef& root = asf.root;
@@ -721,28 +642,34 @@ AsfSkeleton build_skeleton(const AsfFile& asf, std::string_view text, const std:
             sk.rest_offsets.emplace_back(static_cast<float>(root.position[0]), static_cast<float>(root.position[1]),
                                          static_cast<float>(root.position[2]));
             AsfSkeleton::Dofs dofs = root.dofs;
-            const std::array<double, 3> radians = {root.orientation[0] * angle_scale, root.orientation[1] * angle_scale,
-                                                   root.orientation[2] * angle_scale};
-            dofs.axis = euler_rotation(radians, root.axis_order);
+            dofs.axis = axis_frame(root.orientation, root.axis_order, angle_scale);
             out.dofs.push_back(dofs);
             continue;
         }
         const BoneDef& bone = asf.bones[n - 1];
-        const auto p = static_cast<std::size_t>(parent[n]);
+        const auto p = static_cast<std::size_t>(tree.parent[n]);
         sk.joint_names.emplace_back(bone.name);
-        sk.parents.push_back(joint_of[p]);
+        sk.parents.push_back(order.joint_of[p]);
         sk.rest_offsets.push_back(bone_vector[p]);  // the parent's end; zero for the root
         AsfSkeleton::Dofs dofs = bone.dofs;
-        const std::array<double, 3> radians = {bone.axis[0] * angle_scale, bone.axis[1] * angle_scale,
-                                               bone.axis[2] * angle_scale};
-        dofs.axis = euler_rotation(radians, bone.axis_order);
+        dofs.axis = axis_frame(bone.axis, bone.axis_order, angle_scale);
         out.dofs.push_back(dofs);
-        if (children[n].empty()) {
-            sk.end_site_parents.push_back(joint_of[n]);
+        if (tree.children[n].empty()) {
+            sk.end_site_parents.push_back(order.joint_of[n]);
             sk.end_site_offsets.push_back(bone_vector[n]);
         }
     }
     return out;
+}
+
+// Bone names → the skeleton: parents from :hierarchy, then a depth-first walk
+// from the root for a topological joint order.
+AsfSkeleton build_skeleton(const AsfFile& asf, std::string_view text, const std::string& file) {
+    const TextLexer reader(text, file);  // for fail() only
+    const BoneTree tree = link_hierarchy(asf, reader);
+    const JointOrder order = depth_first_order(tree);
+    check_all_reachable(asf, tree, order, reader);
+    return assemble_skeleton(asf, tree, order, bone_vectors(asf, reader));
 }
 
 AsfSkeleton parse_asf(std::string_view text, const std::string& file) {
@@ -777,17 +704,10 @@ void apply_dofs(const AsfSkeleton::Dofs& dofs, const double* values, double angl
     rotation = quat_normalize(quat_mul(quat_mul(dofs.axis, motion), quat_conjugate(dofs.axis)));
 }
 
-std::string clip_name_from_path(const std::string& path) {
-    const std::size_t slash = path.find_last_of("/\\");
-    std::string base = slash == std::string::npos ? path : path.substr(slash + 1);
-    const std::size_t dot = base.find_last_of('.');
-    if (dot != std::string::npos && dot > 0) base.erase(dot);
-    return base;
-}
-
 void read_amc(const AsfSkeleton& asf, std::string_view text, const std::string& file, Clip& clip) {
-    LineReader reader(text, file);
+    TextLexer reader(text, file);
     reader.reject_control_bytes("AMC");
+    reader.skip_utf8_bom();
     const Skeleton& sk = asf.skeleton;
     const auto joints = static_cast<std::size_t>(sk.joint_count());
     std::unordered_map<std::string_view, int> by_name;
@@ -801,8 +721,8 @@ void read_amc(const AsfSkeleton& asf, std::string_view text, const std::string& 
 
     bool degrees = asf.degrees;
     Line line;
-    while (reader.peek(line) && is_section_line(line)) {
-        reader.next(line);
+    while (reader.peek_content_line(line) && is_section_line(line)) {
+        reader.next_content_line(line);
         if (iequals(line.text, ":DEGREES")) degrees = true;
         else if (iequals(line.text, ":RADIANS")) degrees = false;
         // :FULLY-SPECIFIED and other header flags change nothing here.
@@ -828,16 +748,16 @@ void read_amc(const AsfSkeleton& asf, std::string_view text, const std::string& 
         for (std::size_t j = 0; j < joints; ++j)
             if (asf.dofs[j].count > 0 && seen_in_frame[j] != frame)
                 reader.fail(frame_line, "frame " + std::to_string(frame) + " has no line for bone " +
-                                            quoted(sk.joint_names[j]) + " (expected every bone with dofs in every frame)");
+                                            quote_token(sk.joint_names[j]) + " (expected every bone with dofs in every frame)");
     };
-    while (reader.next(line)) {
+    while (reader.next_content_line(line)) {
         split_blanks(line.text, tokens);
         std::int64_t number = 0;
         if (tokens.size() == 1 && parse_integer(tokens[0], number)) {
             finish_frame();
             if (number != frame + 1)
                 reader.fail(line.number, "expected frame number " + std::to_string(frame + 1) + ", found " +
-                                             quoted(tokens[0]) + " (frames are numbered 1, 2, 3, ...)");
+                                             quote_token(tokens[0]) + " (frames are numbered 1, 2, 3, ...)");
             if (static_cast<std::size_t>(number) > max_frames)
                 reader.fail(line.number, "too many frames: " + std::to_string(number) + " × " + std::to_string(joints) +
                                              " joints exceeds the limit of " + std::to_string(kMaxPoseSamples) +
@@ -849,27 +769,27 @@ void read_amc(const AsfSkeleton& asf, std::string_view text, const std::string& 
             continue;
         }
         if (is_section_line(line))
-            reader.fail(line.number, "expected a frame number or a bone line, found " + quoted(tokens[0]) +
+            reader.fail(line.number, "expected a frame number or a bone line, found " + quote_token(tokens[0]) +
                                          " (header keywords go before the first frame)");
-        if (frame == 0) reader.fail(line.number, "expected frame number 1, found " + quoted(tokens[0]));
+        if (frame == 0) reader.fail(line.number, "expected frame number 1, found " + quote_token(tokens[0]));
         const auto it = by_name.find(tokens[0]);
         if (it == by_name.end())
-            reader.fail(line.number, "unknown bone " + quoted(tokens[0]) + " in frame " + std::to_string(frame) +
+            reader.fail(line.number, "unknown bone " + quote_token(tokens[0]) + " in frame " + std::to_string(frame) +
                                          " (expected a bone of the ASF skeleton)");
         const auto j = static_cast<std::size_t>(it->second);
         if (seen_in_frame[j] == frame)
-            reader.fail(line.number, "bone " + quoted(tokens[0]) + " is listed twice in frame " + std::to_string(frame));
+            reader.fail(line.number, "bone " + quote_token(tokens[0]) + " is listed twice in frame " + std::to_string(frame));
         seen_in_frame[j] = static_cast<int>(frame);
         const AsfSkeleton::Dofs& dofs = asf.dofs[j];
         const std::size_t count = tokens.size() - 1;
         if (count != static_cast<std::size_t>(dofs.count))
-            reader.fail(line.number, "bone " + quoted(tokens[0]) + " has " + std::to_string(count) + " values in frame " +
+            reader.fail(line.number, "bone " + quote_token(tokens[0]) + " has " + std::to_string(count) + " values in frame " +
                                          std::to_string(frame) + ", expected " + std::to_string(dofs.count) +
                                          (dofs.count ? " (" + dof_names(dofs) + ")" : std::string(" (it has no dof)")));
         values.resize(count);
         for (std::size_t i = 0; i < count; ++i)
             values[i] = read_number(reader, line.number, tokens[i + 1],
-                                    "value " + std::to_string(i + 1) + " of bone " + quoted(tokens[0]));
+                                    "value " + std::to_string(i + 1) + " of bone " + quote_token(tokens[0]));
         const std::size_t at = static_cast<std::size_t>(frame - 1) * joints + j;
         apply_dofs(dofs, values.data(), angle_scale, clip.rotations[at], clip.translations[at]);
     }
@@ -881,18 +801,7 @@ void read_amc(const AsfSkeleton& asf, std::string_view text, const std::string& 
 std::string read_file(const std::string& path, const char* kind) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw ImportError(path, 0, "cannot open the file for reading");
-    std::string text;
-    constexpr std::size_t kChunk = 1 << 16;
-    std::vector<char> buf(kChunk);
-    while (in) {
-        in.read(buf.data(), static_cast<std::streamsize>(kChunk));
-        const auto got = static_cast<std::size_t>(in.gcount());
-        if (text.size() + got > kMaxFileBytes)
-            throw ImportError(path, 0, std::string("file is larger than the 512 MiB an ") + kind + " file may have");
-        text.append(buf.data(), got);
-    }
-    if (in.bad()) throw ImportError(path, 0, "cannot read the file (a directory, or an I/O error)");
-    return text;
+    return read_capped_text(in, path, std::string("an ") + kind + " file");
 }
 
 }  // namespace
@@ -914,8 +823,8 @@ Clip import_asf_amc(std::string_view asf_text, const std::string& asf_name, std:
     read_amc(asf, amc_text, amc_name, clip);
     // Holds by construction; a parser bug should surface as an error, not as a
     // clip that breaks its users.
-    if (std::string problem = validate_clip(clip); !problem.empty())
-        throw ImportError(amc_name, 0, "inconsistent clip: " + problem);
+    if (const Outcome valid = validate_clip(clip); !valid.ok())
+        throw ImportError(amc_name, 0, "inconsistent clip: " + valid.problem());
     return clip;
 }
 
@@ -927,8 +836,8 @@ Clip load_asf_amc_files(const std::string& asf_path, const std::string& amc_path
 
 Skeleton import_asf_skeleton(std::string_view asf_text, const std::string& asf_name) {
     AsfSkeleton asf = parse_asf(asf_text, asf_name);
-    if (std::string problem = validate_skeleton(asf.skeleton); !problem.empty())
-        throw ImportError(asf_name, 0, "inconsistent skeleton: " + problem);
+    if (const Outcome valid = validate_skeleton(asf.skeleton); !valid.ok())
+        throw ImportError(asf_name, 0, "inconsistent skeleton: " + valid.problem());
     return std::move(asf.skeleton);
 }
 

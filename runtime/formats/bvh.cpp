@@ -25,7 +25,6 @@
 #include <array>
 #include <charconv>
 #include <cerrno>
-#include <climits>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -35,25 +34,23 @@
 #include <unordered_map>
 #include <vector>
 
+#include "runtime/formats/file_names.hpp"
+#include "runtime/formats/text_lexer.hpp"
 #include "runtime/formats/text_number.hpp"
 
 namespace marionette {
 
 namespace {
 
+using namespace text;
+
 constexpr int kMaxJoints = 1024;
 constexpr int kMaxChannelsPerJoint = 6;
 // Frames × joints; 2^24 pose samples is about 470 MB of quaternions and vectors,
 // far beyond any real capture (10 minutes at 120 Hz of 200 joints is 14.4M).
 constexpr std::int64_t kMaxPoseSamples = std::int64_t{1} << 24;
-// Larger offsets, positions or angles are nonsense and would lose all meaning
-// (or overflow) once stored as float.
 // One megahertz: anything faster is not a frame time.
 constexpr double kMinFrameTime = 1.0e-6;
-// Longest token quoted back in an error message.
-constexpr std::size_t kMaxQuotedChars = 40;
-// load_bvh_file refuses bigger files (a device or a mistaken path).
-constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{512} << 20;
 // When both matrix entries that give the Z angle of a Z·X·Y decomposition are
 // below this, X is ±90° (gimbal lock) and Z is set to 0 so Y takes the whole
 // twist. Float quaternions carry ~1e-7 of noise, so a smaller threshold would
@@ -63,139 +60,6 @@ constexpr double kGimbalEpsilon = 1.0e-7;
 // Significant digits for angles in degrees: 9 keeps the round-trip error below
 // 1e-6 degrees, well under the 1e-4 the header promises.
 constexpr int kAngleDigits = 9;
-
-// ---------------------------------------------------------------- characters
-
-bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; }
-bool is_line_end(char c) { return c == '\n' || c == '\r'; }
-bool is_space(char c) { return is_blank(c) || is_line_end(c); }
-
-char ascii_lower(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; }
-
-// Keywords are matched without regard to case: some exporters write "End site"
-// or "HIERARCHY" in other cases, and nothing is lost by accepting them.
-bool iequals(std::string_view a, std::string_view b) {
-    if (a.size() != b.size()) return false;
-    for (std::size_t i = 0; i < a.size(); ++i)
-        if (ascii_lower(a[i]) != ascii_lower(b[i])) return false;
-    return true;
-}
-
-bool istarts_with(std::string_view s, std::string_view prefix) {
-    return s.size() >= prefix.size() && iequals(s.substr(0, prefix.size()), prefix);
-}
-
-std::string_view trim_blanks(std::string_view s) {
-    while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
-    while (!s.empty() && is_blank(s.back())) s.remove_suffix(1);
-    return s;
-}
-
-std::string quote_token(std::string_view token) {
-    if (token.size() > kMaxQuotedChars) return "'" + std::string(token.substr(0, kMaxQuotedChars)) + "...'";
-    return "'" + std::string(token) + "'";
-}
-
-// ---------------------------------------------------------------- numbers
-
-
-// ---------------------------------------------------------------- cursor
-
-struct Token {
-    std::string_view text;
-    int line = 0;
-};
-
-// Position in the text plus the 1-based line number. "\r\n", "\n" and a lone
-// "\r" each end one line, so CRLF, LF and mixed files count lines alike.
-class Cursor {
-public:
-    Cursor(std::string_view text, const std::string& file) : text_(text), file_(file) {}
-
-    [[noreturn]] void fail(int line, const std::string& message) const { throw ImportError(file_, line, message); }
-
-    // Where "found end of file" is reported: the last line with any content
-    // (not the empty line after a final line end).
-    int end_line() const { return last_content_line_; }
-    std::size_t remaining() const { return text_.size() - pos_; }
-
-    void skip_utf8_bom() {
-        if (text_.substr(pos_, 3) == "\xEF\xBB\xBF") pos_ += 3;
-    }
-
-    // Binary data shows itself by control bytes that text never has; refuse
-    // them once, up front, so nothing later needs to think about them.
-    void reject_control_bytes() const {
-        int line = 1;
-        for (std::size_t i = 0; i < text_.size(); ++i) {
-            const auto c = static_cast<unsigned char>(text_[i]);
-            if (c == '\n' || (c == '\r' && (i + 1 == text_.size() || text_[i + 1] != '\n'))) {
-                if (line < INT_MAX) ++line;
-            } else if ((c < 0x20 && !is_space(static_cast<char>(c))) || c == 0x7F) {
-                static constexpr char kHex[] = "0123456789ABCDEF";
-                std::string byte = "0x";
-                byte += kHex[c >> 4];
-                byte += kHex[c & 15];
-                fail(line, "unexpected control byte " + byte + " (expected BVH text; is this a binary file?)");
-            }
-        }
-    }
-
-    // Next token anywhere (line ends skipped); false at end of text.
-    bool next_token(Token& out) {
-        for (;;) {
-            skip_blanks();
-            if (!consume_line_end()) break;
-        }
-        return read_token(out);
-    }
-
-    // Next token on the current line; false at a line end or end of text (the
-    // line end is not consumed).
-    bool next_token_on_line(Token& out) {
-        skip_blanks();
-        return read_token(out);
-    }
-
-    // The rest of the current line, its line end consumed; false at end of text.
-    bool next_line(std::string_view& out, int& line_no) {
-        if (pos_ >= text_.size()) return false;
-        const std::size_t start = pos_;
-        while (pos_ < text_.size() && !is_line_end(text_[pos_])) ++pos_;
-        out = text_.substr(start, pos_ - start);
-        line_no = line_;
-        if (!trim_blanks(out).empty()) last_content_line_ = line_;
-        consume_line_end();
-        return true;
-    }
-
-private:
-    void skip_blanks() {
-        while (pos_ < text_.size() && is_blank(text_[pos_])) ++pos_;
-    }
-    bool consume_line_end() {
-        if (pos_ >= text_.size() || !is_line_end(text_[pos_])) return false;
-        if (text_[pos_] == '\r' && pos_ + 1 < text_.size() && text_[pos_ + 1] == '\n') ++pos_;
-        ++pos_;
-        if (line_ < INT_MAX) ++line_;
-        return true;
-    }
-    bool read_token(Token& out) {
-        if (pos_ >= text_.size() || is_line_end(text_[pos_])) return false;
-        const std::size_t start = pos_;
-        while (pos_ < text_.size() && !is_space(text_[pos_])) ++pos_;
-        out.text = text_.substr(start, pos_ - start);
-        out.line = line_;
-        last_content_line_ = line_;
-        return true;
-    }
-
-    std::string_view text_;
-    const std::string& file_;
-    std::size_t pos_ = 0;
-    int line_ = 1;
-    int last_content_line_ = 1;
-};
 
 std::string found(const Token* token) { return token ? ", found " + quote_token(token->text) : ", found end of file"; }
 
@@ -238,7 +102,7 @@ std::string block_name(const Hierarchy& h, const OpenBlock& block) {
 }
 
 // The values after a keyword, all on its line.
-vec3 read_offset(Cursor& cur, const Token& keyword) {
+vec3 read_offset(TextLexer& cur, const Token& keyword) {
     std::array<double, 3> v{};
     int count = 0;
     Token t;
@@ -257,7 +121,7 @@ vec3 read_offset(Cursor& cur, const Token& keyword) {
     return vec3(static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]));
 }
 
-JointChannels read_channels(Cursor& cur, const Token& keyword) {
+JointChannels read_channels(TextLexer& cur, const Token& keyword) {
     Token t;
     if (!cur.next_token_on_line(t)) cur.fail(keyword.line, "expected the channel count after CHANNELS, found end of line");
     std::int64_t declared = 0;
@@ -290,7 +154,7 @@ JointChannels read_channels(Cursor& cur, const Token& keyword) {
 }
 
 // After ROOT/JOINT: the name, then '{' (on the same line or the next).
-void open_joint(Cursor& cur, Hierarchy& h, std::vector<OpenBlock>& stack,
+void open_joint(TextLexer& cur, Hierarchy& h, std::vector<OpenBlock>& stack,
                 std::unordered_map<std::string_view, int>& name_lines, const Token& keyword, int parent) {
     Token name;
     if (!cur.next_token_on_line(name) || name.text.find_first_of("{}") != std::string_view::npos)
@@ -324,7 +188,7 @@ void open_joint(Cursor& cur, Hierarchy& h, std::vector<OpenBlock>& stack,
 }
 
 // Reads from after "HIERARCHY" up to and including the MOTION keyword.
-Hierarchy read_hierarchy(Cursor& cur) {
+Hierarchy read_hierarchy(TextLexer& cur) {
     Hierarchy h;
     std::vector<OpenBlock> stack;
     std::unordered_map<std::string_view, int> name_lines;
@@ -410,7 +274,7 @@ Hierarchy read_hierarchy(Cursor& cur) {
 // ---------------------------------------------------------------- motion
 
 // "Frames: 69", "Frames:69", "Frames 69" (any case, any blanks).
-std::int64_t parse_frames_line(const Cursor& cur, std::string_view line, int line_no) {
+std::int64_t parse_frames_line(const TextLexer& cur, std::string_view line, int line_no) {
     std::string_view rest = trim_blanks(line);
     const char* expected = "expected 'Frames: <count>' after MOTION";
     if (!istarts_with(rest, "Frames")) cur.fail(line_no, std::string(expected) + ", found " + quote_token(rest));
@@ -424,7 +288,7 @@ std::int64_t parse_frames_line(const Cursor& cur, std::string_view line, int lin
 }
 
 // "Frame Time: .0083333", "Frame Time:0.033", "FrameTime 0.033" (any case).
-double parse_frame_time_line(const Cursor& cur, std::string_view line, int line_no) {
+double parse_frame_time_line(const TextLexer& cur, std::string_view line, int line_no) {
     std::string_view rest = trim_blanks(line);
     const char* expected = "expected 'Frame Time: <seconds>' after Frames";
     if (!istarts_with(rest, "Frame")) cur.fail(line_no, std::string(expected) + ", found " + quote_token(rest));
@@ -467,7 +331,7 @@ void fill_pose(const Hierarchy& h, const std::vector<double>& values, quat* rota
     }
 }
 
-void read_motion(Cursor& cur, const Hierarchy& h, Clip& clip) {
+void read_motion(TextLexer& cur, const Hierarchy& h, Clip& clip) {
     std::string_view line;
     int line_no = 0;
     do {
@@ -508,13 +372,7 @@ void read_motion(Cursor& cur, const Hierarchy& h, Clip& clip) {
             cur.fail(line_no, "expected end of file after " + std::to_string(frames) +
                                   " frames (Frames: " + std::to_string(frames) + "), found another frame line");
         std::int64_t count = 0;
-        std::size_t pos = 0;
-        while (pos < line.size()) {
-            while (pos < line.size() && is_blank(line[pos])) ++pos;
-            if (pos == line.size()) break;
-            const std::size_t start = pos;
-            while (pos < line.size() && !is_blank(line[pos])) ++pos;
-            const std::string_view token = line.substr(start, pos - start);
+        for_each_word(line, [&](std::string_view token) {
             if (count < channels) {
                 const NumberStatus status = parse_real(token, values[static_cast<std::size_t>(count)]);
                 if (status == NumberStatus::too_large)
@@ -524,7 +382,7 @@ void read_motion(Cursor& cur, const Hierarchy& h, Clip& clip) {
                                           std::to_string(frame + 1) + "), found " + quote_token(token));
             }
             ++count;
-        }
+        });
         if (count != channels)
             cur.fail(line_no, "frame " + std::to_string(frame + 1) + " has " + std::to_string(count) +
                                   " values, expected " + std::to_string(channels) + " (one per channel)");
@@ -535,15 +393,6 @@ void read_motion(Cursor& cur, const Hierarchy& h, Clip& clip) {
     if (frame < frames)
         cur.fail(cur.end_line(), "expected " + std::to_string(frames) + " frames (Frames: " + std::to_string(frames) +
                                  "), but the file ends after " + std::to_string(frame));
-}
-
-// "dir/walk.bvh" → "walk"; both separators, since names may come from Windows.
-std::string clip_name_from_path(const std::string& path) {
-    const std::size_t slash = path.find_last_of("/\\");
-    std::string base = slash == std::string::npos ? path : path.substr(slash + 1);
-    const std::size_t dot = base.find_last_of('.');
-    if (dot != std::string::npos && dot > 0) base.erase(dot);
-    return base;
 }
 
 // ---------------------------------------------------------------- export
@@ -607,70 +456,21 @@ bool valid_export_name(const std::string& name) {
     return true;
 }
 
-}  // namespace
-
-Clip import_bvh(std::string_view text, const std::string& file_name) {
-    Cursor cur(text, file_name);
-    cur.reject_control_bytes();
-    cur.skip_utf8_bom();
-    Token first;
-    const bool have = cur.next_token(first);
-    if (!have || !iequals(first.text, "HIERARCHY"))
-        cur.fail(have ? first.line : cur.end_line(),
-                 "expected 'HIERARCHY' at the start of a BVH file" + found(have ? &first : nullptr));
-    const Hierarchy h = read_hierarchy(cur);
-
-    Clip clip;
-    clip.name = clip_name_from_path(file_name);
-    clip.skeleton = h.skeleton;
-    clip.length_unit = 1.0;
-    clip.animated_translation.resize(h.channels.size());
-    for (std::size_t j = 0; j < h.channels.size(); ++j) clip.animated_translation[j] = h.channels[j].has_position;
-    read_motion(cur, h, clip);
-    // Holds by construction; kept as a guard so a parser bug surfaces as an
-    // error rather than as a clip that breaks its users.
-    if (std::string problem = validate_clip(clip); !problem.empty()) cur.fail(0, "inconsistent clip: " + problem);
-    return clip;
-}
-
-Clip load_bvh_file(const std::string& path) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec))
-        throw ImportError(path, 0, "is a directory, expected a BVH file");
-    errno = 0;
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        const int err = errno;  // set by the failed open
-        throw ImportError(path, 0, "cannot open the file for reading" +
-                                       (err ? ": " + std::generic_category().message(err) : std::string()));
-    }
-    std::string text;
-    constexpr std::size_t kChunk = 1 << 16;
-    std::vector<char> buf(kChunk);
-    while (in) {
-        in.read(buf.data(), static_cast<std::streamsize>(kChunk));
-        const auto got = static_cast<std::size_t>(in.gcount());
-        if (text.size() + got > kMaxFileBytes)
-            throw ImportError(path, 0, "file is larger than the 512 MiB a BVH clip may have");
-        text.append(buf.data(), got);
-    }
-    if (in.bad()) throw ImportError(path, 0, "cannot read the file (a directory, or an I/O error)");
-    return import_bvh(text, path);
-}
-
-std::string export_bvh(const Clip& clip) {
-    if (std::string problem = validate_clip(clip); !problem.empty())
-        throw std::invalid_argument("export_bvh: " + problem);
-    const Skeleton& sk = clip.skeleton;
-    const auto joints = static_cast<std::size_t>(sk.joint_count());
-    for (const std::string& name : sk.joint_names)
+void check_exportable(const Clip& clip) {
+    if (const Outcome valid = validate_clip(clip); !valid.ok())
+        throw std::invalid_argument("export_bvh: " + valid.problem());
+    for (const std::string& name : clip.skeleton.joint_names)
         if (!valid_export_name(name))
             throw std::invalid_argument("export_bvh: joint name " + quote_token(name) +
                                         " cannot be written to BVH (expected one word without braces)");
+}
 
-    // Position channels for flagged joints and roots, and also for any joint
-    // whose translation ever leaves its rest offset: otherwise that motion
-    // would be lost, and the promise is that the file imports to the same poses.
+// Position channels for flagged joints and roots, and also for any joint whose
+// translation ever leaves its rest offset: otherwise that motion would be lost,
+// and the promise is that the file imports to the same poses.
+std::vector<bool> joints_with_position_channels(const Clip& clip) {
+    const Skeleton& sk = clip.skeleton;
+    const auto joints = static_cast<std::size_t>(sk.joint_count());
     std::vector<bool> positions(joints, false);
     for (std::size_t j = 0; j < joints; ++j) positions[j] = clip.animated_translation[j] || sk.parents[j] == kNoParent;
     for (int f = 0; f < clip.frame_count; ++f) {
@@ -678,42 +478,79 @@ std::string export_bvh(const Clip& clip) {
         for (std::size_t j = 0; j < joints; ++j)
             if (t[j] != sk.rest_offsets[j]) positions[j] = true;
     }
+    return positions;
+}
 
-    std::vector<std::vector<int>> children(joints);
-    std::vector<std::vector<std::size_t>> end_sites(joints);
+// Each joint's child joints and end sites, in skeleton order.
+struct JointTree {
+    std::vector<std::vector<int>> children;
+    std::vector<std::vector<std::size_t>> end_sites;
+};
+
+JointTree joint_tree(const Skeleton& sk) {
+    const auto joints = static_cast<std::size_t>(sk.joint_count());
+    JointTree tree{std::vector<std::vector<int>>(joints), std::vector<std::vector<std::size_t>>(joints)};
     for (std::size_t j = 0; j < joints; ++j)
-        if (sk.parents[j] != kNoParent) children[static_cast<std::size_t>(sk.parents[j])].push_back(static_cast<int>(j));
+        if (sk.parents[j] != kNoParent)
+            tree.children[static_cast<std::size_t>(sk.parents[j])].push_back(static_cast<int>(j));
     for (std::size_t e = 0; e < sk.end_site_parents.size(); ++e)
-        end_sites[static_cast<std::size_t>(sk.end_site_parents[e])].push_back(e);
+        tree.end_sites[static_cast<std::size_t>(sk.end_site_parents[e])].push_back(e);
+    return tree;
+}
 
-    std::string out = "HIERARCHY\n";
-    std::vector<int> order;  // joints in the order written, which is the channel order
+void indent(std::string& out, std::size_t depth) { out.append(depth, '\t'); }
+
+void append_offset_line(std::string& out, std::size_t depth, vec3 offset) {
+    indent(out, depth);
+    out += "OFFSET ";
+    append_float(out, offset.x);
+    out += ' ';
+    append_float(out, offset.y);
+    out += ' ';
+    append_float(out, offset.z);
+    out += '\n';
+}
+
+// "ROOT name" or "JOINT name", '{', OFFSET and CHANNELS; the '}' comes after the children.
+void open_joint_block(std::string& out, const Skeleton& sk, std::size_t joint, std::size_t depth, bool position_channels) {
+    indent(out, depth);
+    out += sk.parents[joint] == kNoParent ? "ROOT " : "JOINT ";
+    out += sk.joint_names[joint];
+    out += '\n';
+    indent(out, depth);
+    out += "{\n";
+    append_offset_line(out, depth + 1, sk.rest_offsets[joint]);
+    indent(out, depth + 1);
+    out += position_channels ? "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+                             : "CHANNELS 3 Zrotation Xrotation Yrotation\n";
+}
+
+void write_end_site(std::string& out, std::size_t depth, vec3 offset) {
+    indent(out, depth);
+    out += "End Site\n";
+    indent(out, depth);
+    out += "{\n";
+    append_offset_line(out, depth + 1, offset);
+    indent(out, depth);
+    out += "}\n";
+}
+
+// The HIERARCHY section, depth-first without recursion. Returns the joints in
+// the order written, which is the channel order.
+std::vector<int> write_hierarchy(std::string& out, const Skeleton& sk, const std::vector<bool>& positions) {
+    const auto joints = static_cast<std::size_t>(sk.joint_count());
+    const JointTree tree = joint_tree(sk);
+    out += "HIERARCHY\n";
+    std::vector<int> order;
     order.reserve(joints);
     struct Frame {
         int joint;
         std::size_t next_child;
     };
-    std::vector<Frame> stack;  // depth-first without recursion
-    auto indent = [&out](std::size_t depth) { out.append(depth, '\t'); };
+    std::vector<Frame> stack;
     auto open = [&](int j, std::size_t depth) {
         const auto ju = static_cast<std::size_t>(j);
-        indent(depth);
-        out += sk.parents[ju] == kNoParent ? "ROOT " : "JOINT ";
-        out += sk.joint_names[ju];
-        out += '\n';
-        indent(depth);
-        out += "{\n";
-        indent(depth + 1);
-        out += "OFFSET ";
-        append_float(out, sk.rest_offsets[ju].x);
-        out += ' ';
-        append_float(out, sk.rest_offsets[ju].y);
-        out += ' ';
-        append_float(out, sk.rest_offsets[ju].z);
-        out += '\n';
-        indent(depth + 1);
-        out += positions[ju] ? "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
-                             : "CHANNELS 3 Zrotation Xrotation Yrotation\n";
+        open_joint_block(out, sk, ju, depth, positions[ju]);
         order.push_back(j);
         stack.push_back({j, 0});
     };
@@ -724,33 +561,23 @@ std::string export_bvh(const Clip& clip) {
             Frame& top = stack.back();
             const auto ju = static_cast<std::size_t>(top.joint);
             const std::size_t depth = stack.size() - 1;
-            if (top.next_child < children[ju].size()) {
-                const int child = children[ju][top.next_child++];
+            if (top.next_child < tree.children[ju].size()) {
+                const int child = tree.children[ju][top.next_child++];
                 open(child, depth + 1);  // may reallocate: `top` is dead from here
                 continue;
             }
-            for (std::size_t e : end_sites[ju]) {
-                indent(depth + 1);
-                out += "End Site\n";
-                indent(depth + 1);
-                out += "{\n";
-                indent(depth + 2);
-                out += "OFFSET ";
-                append_float(out, sk.end_site_offsets[e].x);
-                out += ' ';
-                append_float(out, sk.end_site_offsets[e].y);
-                out += ' ';
-                append_float(out, sk.end_site_offsets[e].z);
-                out += '\n';
-                indent(depth + 1);
-                out += "}\n";
-            }
-            indent(depth);
+            for (std::size_t e : tree.end_sites[ju]) write_end_site(out, depth + 1, sk.end_site_offsets[e]);
+            indent(out, depth);
             out += "}\n";
             stack.pop_back();
         }
     }
+    return order;
+}
 
+// The MOTION section: per frame, each joint in `order` as its positions (if
+// it has position channels) then Z, X, Y angles in degrees.
+void write_motion(std::string& out, const Clip& clip, const std::vector<bool>& positions, const std::vector<int>& order) {
     out += "MOTION\nFrames: ";
     out += std::to_string(clip.frame_count);
     out += "\nFrame Time: ";
@@ -781,6 +608,55 @@ std::string export_bvh(const Clip& clip) {
         }
         out += '\n';
     }
+}
+
+}  // namespace
+
+Clip import_bvh(std::string_view text, const std::string& file_name) {
+    TextLexer cur(text, file_name);
+    cur.reject_control_bytes("BVH");
+    cur.skip_utf8_bom();
+    Token first;
+    const bool have = cur.next_token(first);
+    if (!have || !iequals(first.text, "HIERARCHY"))
+        cur.fail(have ? first.line : cur.end_line(),
+                 "expected 'HIERARCHY' at the start of a BVH file" + found(have ? &first : nullptr));
+    const Hierarchy h = read_hierarchy(cur);
+
+    Clip clip;
+    clip.name = clip_name_from_path(file_name);
+    clip.skeleton = h.skeleton;
+    clip.length_unit = 1.0;
+    clip.animated_translation.resize(h.channels.size());
+    for (std::size_t j = 0; j < h.channels.size(); ++j) clip.animated_translation[j] = h.channels[j].has_position;
+    read_motion(cur, h, clip);
+    // Holds by construction; kept as a guard so a parser bug surfaces as an
+    // error rather than as a clip that breaks its users.
+    if (const Outcome valid = validate_clip(clip); !valid.ok()) cur.fail(0, "inconsistent clip: " + valid.problem());
+    return clip;
+}
+
+Clip load_bvh_file(const std::string& path) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+        throw ImportError(path, 0, "is a directory, expected a BVH file");
+    errno = 0;
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        const int err = errno;  // set by the failed open
+        throw ImportError(path, 0, "cannot open the file for reading" +
+                                       (err ? ": " + std::generic_category().message(err) : std::string()));
+    }
+    const std::string text = read_capped_text(in, path, "a BVH clip");
+    return import_bvh(text, path);
+}
+
+std::string export_bvh(const Clip& clip) {
+    check_exportable(clip);
+    const std::vector<bool> positions = joints_with_position_channels(clip);
+    std::string out;
+    const std::vector<int> order = write_hierarchy(out, clip.skeleton, positions);
+    write_motion(out, clip, positions, order);
     return out;
 }
 

@@ -3,6 +3,8 @@
 #include <zlib.h>
 
 #include <cstring>
+#include <limits>
+#include <optional>
 
 namespace marionette {
 
@@ -10,6 +12,7 @@ namespace {
 constexpr unsigned char kChunkMagic[4] = {'C', 'H', 'N', 'K'};
 constexpr size_t kChunkHeaderSize = 4 + 8 + 4 + 4 + 4;  // magic, first tick, ticks, payload size, crc
 // Payload tags. 0x00–0x7F: a tick record whose low 7 bits say which fields changed.
+constexpr std::uint8_t kTickRecordTagLimit = 0x80;  // tags below it are tick records
 constexpr std::uint8_t kTagConfigChange = 0x80;
 constexpr std::uint8_t kTagEnd = 0x81;
 // Bounds that keep a corrupt length from allocating absurd amounts.
@@ -160,151 +163,180 @@ std::vector<std::uint8_t> encode_input_log(const InputLogHeader& header, const s
     return out;
 }
 
+namespace {
+
+constexpr size_t kFixedHeaderSize = 8 + 4 + 4 + 8 + 4;  // magic, version, tick rate, clip-data hash, config length
+constexpr size_t kCrcSize = 4;
+constexpr std::uint32_t kMaxTickRateHz = 100000;
+
+// Reads and checks the header; a bad one throws (nothing can be replayed
+// without it). Returns the offset of the first chunk.
+size_t decode_header(const std::uint8_t* data, size_t size, const std::string& file, InputLogHeader& header) {
+    if (size < kFixedHeaderSize + kCrcSize)
+        throw import_error_at_byte(file, 0, "file is too short to be an input log (" + std::to_string(size) + " bytes)");
+    if (std::memcmp(data, kInputLogMagic, 8) != 0)
+        throw import_error_at_byte(file, 0, "not a marionette input log (bad magic)");
+    header.version = get_u32(data + 8);
+    if (header.version != kInputLogVersion)
+        throw import_error_at_byte(file, 8, "unsupported input log version " + std::to_string(header.version) +
+                                                " (this build reads version " + std::to_string(kInputLogVersion) + ")");
+    header.tick_rate_hz = get_u32(data + 12);
+    header.clip_data_hash = get_u64(data + 16);
+    const std::uint32_t config_size = get_u32(data + 24);
+    if (config_size > kMaxConfigBytes || config_size > size - kFixedHeaderSize - kCrcSize)
+        throw import_error_at_byte(file, 24, "header's configuration length " + std::to_string(config_size) +
+                                                 " exceeds the file");
+    const size_t header_end = kFixedHeaderSize + config_size;
+    if (get_u32(data + header_end) != crc32_of(data, header_end))
+        throw import_error_at_byte(file, static_cast<std::int64_t>(header_end), "header CRC mismatch: the header is corrupt");
+    if (header.tick_rate_hz == 0 || header.tick_rate_hz > kMaxTickRateHz)
+        throw import_error_at_byte(file, 12, "tick rate " + std::to_string(header.tick_rate_hz) + " Hz is out of range");
+    header.config_text.assign(reinterpret_cast<const char*>(data + kFixedHeaderSize), config_size);
+    return header_end + kCrcSize;
+}
+
+// Why decoding stops at a chunk (the log is replayed up to it); nullopt: the chunk is sound.
+using ChunkDefect = std::optional<std::string>;
+
+struct ChunkHeader {
+    std::uint64_t first_tick = 0;
+    std::uint32_t ticks = 0;
+    std::uint32_t payload_size = 0;
+};
+
+// The chunk header at `pos`, checked against the file's size, its CRC (which
+// covers the payload too) and the tick the log has reached.
+ChunkDefect read_chunk_header(const std::uint8_t* data, size_t size, size_t pos, std::uint64_t next_tick, ChunkHeader& out) {
+    if (size - pos < kChunkHeaderSize) return "incomplete chunk header";
+    const std::uint8_t* chunk = data + pos;
+    if (std::memcmp(chunk, kChunkMagic, 4) != 0) return "bad chunk magic";
+    out.first_tick = get_u64(chunk + 4);
+    out.ticks = get_u32(chunk + 12);
+    out.payload_size = get_u32(chunk + 16);
+    const std::uint32_t crc = get_u32(chunk + 20);
+    if (out.ticks > kMaxChunkTicks)
+        return "chunk claims " + std::to_string(out.ticks) + " ticks, more than a chunk may hold";
+    if (out.payload_size > kMaxChunkPayload || out.payload_size > size - pos - kChunkHeaderSize)
+        return "chunk payload of " + std::to_string(out.payload_size) + " bytes runs past the end of the file";
+    std::uint32_t expect = crc32_of(chunk + 4, 16);
+    expect = crc32_of(chunk + kChunkHeaderSize, out.payload_size, expect);
+    if (expect != crc) return "chunk CRC mismatch";
+    if (out.first_tick != next_tick)
+        return "chunk starts at tick " + std::to_string(out.first_tick) + ", expected " + std::to_string(next_tick);
+    return std::nullopt;
+}
+
+bool in_range(std::int64_t v, std::int64_t lo, std::int64_t hi) { return v >= lo && v <= hi; }
+
+// Whether every field fits its TickInput member (fields_of's order).
+bool fields_in_range(const std::int64_t (&f)[kFieldCount]) {
+    constexpr std::int64_t kAxisMin = std::numeric_limits<std::int16_t>::min();
+    constexpr std::int64_t kAxisMax = std::numeric_limits<std::int16_t>::max();
+    constexpr std::int64_t kTriggerMax = std::numeric_limits<std::uint16_t>::max();
+    constexpr std::int64_t kButtonsMax = std::numeric_limits<std::uint32_t>::max();
+    return in_range(f[0], kAxisMin, kAxisMax) && in_range(f[1], kAxisMin, kAxisMax) && in_range(f[2], kAxisMin, kAxisMax) &&
+           in_range(f[3], kAxisMin, kAxisMax) && in_range(f[4], 0, kTriggerMax) && in_range(f[5], 0, kTriggerMax) &&
+           in_range(f[6], 0, kButtonsMax);
+}
+
+// fields_of's inverse (the fields are in range).
+TickInput tick_input_of(const std::int64_t (&f)[kFieldCount]) {
+    TickInput input;
+    input.left_x = static_cast<std::int16_t>(f[0]);
+    input.left_y = static_cast<std::int16_t>(f[1]);
+    input.right_x = static_cast<std::int16_t>(f[2]);
+    input.right_y = static_cast<std::int16_t>(f[3]);
+    input.left_trigger = static_cast<std::uint16_t>(f[4]);
+    input.right_trigger = static_cast<std::uint16_t>(f[5]);
+    input.buttons = static_cast<std::uint32_t>(f[6]);
+    return input;
+}
+
+// What one chunk holds, kept apart from the log until the whole chunk decodes.
+struct DecodedChunk {
+    std::vector<TickInput> ticks;
+    std::vector<InputLogConfigChange> config_changes;
+    bool complete = false;  // it holds the end marker
+};
+
+// A tick record after its tag: a zigzag delta for each field whose tag bit is
+// set, then how many ticks (at least one, at most `ticks_left`) repeat the input.
+ChunkDefect decode_tick_record(std::uint8_t tag, Reader& r, std::int64_t (&fields)[kFieldCount], std::uint64_t ticks_left,
+                               DecodedChunk& out) {
+    for (int i = 0; i < kFieldCount; ++i) {
+        if (!(tag & (1u << i))) continue;
+        std::uint64_t z = 0;
+        if (!r.varint(z)) return "truncated field value";
+        // Fields stay in range between records, so a delta beyond 2^32 can
+        // only be corrupt (and would overflow the sum).
+        const std::int64_t delta = unzigzag(z);
+        if (delta < -kMaxFieldDelta || delta > kMaxFieldDelta)
+            return std::string(kFieldNames[i]) + " changes by " + std::to_string(delta) + " at payload byte " +
+                   std::to_string(r.pos) + ", more than any input value can";
+        fields[i] += delta;
+    }
+    std::uint64_t repeat = 0;
+    if (!r.varint(repeat) || repeat == 0) return "bad repeat count";
+    if (repeat > ticks_left) return "more ticks than the chunk header states";
+    if (!fields_in_range(fields)) return "input value out of range";
+    out.ticks.insert(out.ticks.end(), static_cast<size_t>(repeat), tick_input_of(fields));
+    return std::nullopt;
+}
+
+// A configuration-change record after its tag: the text's length, then the text.
+ChunkDefect decode_config_change(Reader& r, std::uint64_t before_tick, DecodedChunk& out) {
+    std::uint64_t len = 0;
+    if (!r.varint(len) || len > kMaxConfigBytes || len > r.size - r.pos) return "bad configuration-change length";
+    InputLogConfigChange change;
+    change.before_tick = before_tick;
+    change.config_text.assign(reinterpret_cast<const char*>(r.data + r.pos), static_cast<size_t>(len));
+    r.pos += static_cast<size_t>(len);
+    out.config_changes.push_back(std::move(change));
+    return std::nullopt;
+}
+
+// A chunk's records (tick records, configuration changes, the end marker),
+// whose ticks must add up to what its header states.
+ChunkDefect decode_chunk_payload(const std::uint8_t* payload, const ChunkHeader& header, DecodedChunk& out) {
+    Reader r{payload, header.payload_size};
+    std::int64_t fields[kFieldCount] = {0, 0, 0, 0, 0, 0, 0};  // the delta base starts at zero in each chunk
+    while (r.pos < r.size) {
+        const std::uint8_t tag = payload[r.pos++];
+        ChunkDefect defect;
+        if (out.complete) defect = "data after the end marker";
+        else if (tag < kTickRecordTagLimit) defect = decode_tick_record(tag, r, fields, header.ticks - out.ticks.size(), out);
+        else if (tag == kTagConfigChange) defect = decode_config_change(r, header.first_tick + out.ticks.size(), out);
+        else if (tag == kTagEnd) out.complete = true;
+        else defect = "unknown record tag " + std::to_string(tag);
+        if (defect) return defect;
+    }
+    if (out.ticks.size() != header.ticks) return "chunk holds fewer ticks than its header states";
+    return std::nullopt;
+}
+
+}  // namespace
+
 DecodedInputLog decode_input_log(const std::vector<std::uint8_t>& bytes, const std::string& file) {
     DecodedInputLog log;
     const size_t size = bytes.size();
     const std::uint8_t* data = bytes.data();
-    constexpr size_t kFixedHeader = 8 + 4 + 4 + 8 + 4;
-    if (size < kFixedHeader + 4)
-        throw import_error_at_byte(file, 0, "file is too short to be an input log (" + std::to_string(size) + " bytes)");
-    if (std::memcmp(data, kInputLogMagic, 8) != 0)
-        throw import_error_at_byte(file, 0, "not a marionette input log (bad magic)");
-    log.header.version = get_u32(data + 8);
-    if (log.header.version != kInputLogVersion)
-        throw import_error_at_byte(file, 8, "unsupported input log version " + std::to_string(log.header.version) +
-                                                " (this build reads version " + std::to_string(kInputLogVersion) + ")");
-    log.header.tick_rate_hz = get_u32(data + 12);
-    log.header.clip_data_hash = get_u64(data + 16);
-    const std::uint32_t config_size = get_u32(data + 24);
-    if (config_size > kMaxConfigBytes || config_size > size - kFixedHeader - 4)
-        throw import_error_at_byte(file, 24, "header's configuration length " + std::to_string(config_size) +
-                                                 " exceeds the file");
-    const size_t header_end = kFixedHeader + config_size;
-    if (get_u32(data + header_end) != crc32_of(data, header_end))
-        throw import_error_at_byte(file, static_cast<std::int64_t>(header_end), "header CRC mismatch: the header is corrupt");
-    if (log.header.tick_rate_hz == 0 || log.header.tick_rate_hz > 100000)
-        throw import_error_at_byte(file, 12, "tick rate " + std::to_string(log.header.tick_rate_hz) + " Hz is out of range");
-    log.header.config_text.assign(reinterpret_cast<const char*>(data + kFixedHeader), config_size);
-
-    size_t pos = header_end + 4;
+    size_t pos = decode_header(data, size, file, log.header);
     log.good_bytes = static_cast<std::int64_t>(pos);
-    auto stop = [&](size_t at, const std::string& why) {
-        log.warning = file + ": input log truncated or corrupt at byte " + std::to_string(at) + ": " + why +
-                      "; replaying the " + std::to_string(log.ticks.size()) + " ticks before it";
-    };
     while (pos < size) {
-        if (log.complete) {
-            stop(pos, "data after the end marker");
+        ChunkHeader header;
+        DecodedChunk chunk;
+        ChunkDefect defect = log.complete ? ChunkDefect("data after the end marker")
+                                          : read_chunk_header(data, size, pos, log.ticks.size(), header);
+        if (!defect) defect = decode_chunk_payload(data + pos + kChunkHeaderSize, header, chunk);
+        if (defect) {
+            log.warning = file + ": input log truncated or corrupt at byte " + std::to_string(pos) + ": " + *defect +
+                          "; replaying the " + std::to_string(log.ticks.size()) + " ticks before it";
             break;
         }
-        if (size - pos < kChunkHeaderSize) {
-            stop(pos, "incomplete chunk header");
-            break;
-        }
-        const std::uint8_t* chunk = data + pos;
-        if (std::memcmp(chunk, kChunkMagic, 4) != 0) {
-            stop(pos, "bad chunk magic");
-            break;
-        }
-        const std::uint64_t first_tick = get_u64(chunk + 4);
-        const std::uint32_t ticks = get_u32(chunk + 12);
-        const std::uint32_t payload_size = get_u32(chunk + 16);
-        const std::uint32_t crc = get_u32(chunk + 20);
-        if (ticks > kMaxChunkTicks) {
-            stop(pos, "chunk claims " + std::to_string(ticks) + " ticks, more than a chunk may hold");
-            break;
-        }
-        if (payload_size > kMaxChunkPayload || payload_size > size - pos - kChunkHeaderSize) {
-            stop(pos, "chunk payload of " + std::to_string(payload_size) + " bytes runs past the end of the file");
-            break;
-        }
-        const std::uint8_t* payload = chunk + kChunkHeaderSize;
-        std::uint32_t expect = crc32_of(chunk + 4, 16);
-        expect = crc32_of(payload, payload_size, expect);
-        if (expect != crc) {
-            stop(pos, "chunk CRC mismatch");
-            break;
-        }
-        if (first_tick != log.ticks.size()) {
-            stop(pos, "chunk starts at tick " + std::to_string(first_tick) + ", expected " + std::to_string(log.ticks.size()));
-            break;
-        }
-        // Decode into a scratch list first, so a chunk that passes its CRC but is
-        // internally inconsistent is dropped whole.
-        std::vector<TickInput> chunk_ticks_decoded;
-        std::vector<InputLogConfigChange> chunk_changes;
-        std::uint64_t chunk_ticks = 0;
-        bool chunk_complete = false;
-        std::string error;
-        Reader r{payload, payload_size};
-        std::int64_t fields[kFieldCount] = {0, 0, 0, 0, 0, 0, 0};
-        while (r.pos < r.size && error.empty()) {
-            const std::uint8_t tag = payload[r.pos++];
-            if (chunk_complete) {
-                error = "data after the end marker";
-            } else if (tag < 0x80) {
-                for (int i = 0; i < kFieldCount && error.empty(); ++i) {
-                    if (!(tag & (1u << i))) continue;
-                    std::uint64_t z = 0;
-                    if (!r.varint(z)) {
-                        error = "truncated field value";
-                    } else {
-                        // Fields stay in range between records, so a delta beyond
-                        // 2^32 can only be corrupt (and would overflow the sum).
-                        const std::int64_t delta = unzigzag(z);
-                        if (delta < -kMaxFieldDelta || delta > kMaxFieldDelta)
-                            error = std::string(kFieldNames[i]) + " changes by " + std::to_string(delta) +
-                                    " at payload byte " + std::to_string(r.pos) + ", more than any input value can";
-                        else
-                            fields[i] += delta;
-                    }
-                }
-                std::uint64_t repeat = 0;
-                if (error.empty() && (!r.varint(repeat) || repeat == 0)) error = "bad repeat count";
-                if (error.empty() && repeat > ticks - chunk_ticks) error = "more ticks than the chunk header states";
-                const bool axes_ok = fields[0] >= -32768 && fields[0] <= 32767 && fields[1] >= -32768 &&
-                                     fields[1] <= 32767 && fields[2] >= -32768 && fields[2] <= 32767 &&
-                                     fields[3] >= -32768 && fields[3] <= 32767;
-                const bool rest_ok = fields[4] >= 0 && fields[4] <= 65535 && fields[5] >= 0 && fields[5] <= 65535 &&
-                                     fields[6] >= 0 && fields[6] <= 0xffffffffll;
-                if (error.empty() && !(axes_ok && rest_ok)) error = "input value out of range";
-                if (!error.empty()) break;
-                TickInput input;
-                input.left_x = static_cast<std::int16_t>(fields[0]);
-                input.left_y = static_cast<std::int16_t>(fields[1]);
-                input.right_x = static_cast<std::int16_t>(fields[2]);
-                input.right_y = static_cast<std::int16_t>(fields[3]);
-                input.left_trigger = static_cast<std::uint16_t>(fields[4]);
-                input.right_trigger = static_cast<std::uint16_t>(fields[5]);
-                input.buttons = static_cast<std::uint32_t>(fields[6]);
-                chunk_ticks_decoded.insert(chunk_ticks_decoded.end(), static_cast<size_t>(repeat), input);
-                chunk_ticks += repeat;
-            } else if (tag == kTagConfigChange) {
-                std::uint64_t len = 0;
-                if (!r.varint(len) || len > kMaxConfigBytes || len > r.size - r.pos) {
-                    error = "bad configuration-change length";
-                    break;
-                }
-                InputLogConfigChange change;
-                change.before_tick = log.ticks.size() + chunk_ticks;
-                change.config_text.assign(reinterpret_cast<const char*>(payload + r.pos), static_cast<size_t>(len));
-                r.pos += static_cast<size_t>(len);
-                chunk_changes.push_back(std::move(change));
-            } else if (tag == kTagEnd) {
-                chunk_complete = true;
-            } else {
-                error = "unknown record tag " + std::to_string(tag);
-            }
-        }
-        if (error.empty() && chunk_ticks != ticks) error = "chunk holds fewer ticks than its header states";
-        if (!error.empty()) {
-            stop(pos, error);
-            break;
-        }
-        log.ticks.insert(log.ticks.end(), chunk_ticks_decoded.begin(), chunk_ticks_decoded.end());
-        for (InputLogConfigChange& change : chunk_changes) log.config_changes.push_back(std::move(change));
-        log.complete = chunk_complete;
-        pos += kChunkHeaderSize + payload_size;
+        log.ticks.insert(log.ticks.end(), chunk.ticks.begin(), chunk.ticks.end());
+        for (InputLogConfigChange& change : chunk.config_changes) log.config_changes.push_back(std::move(change));
+        log.complete = chunk.complete;
+        pos += kChunkHeaderSize + header.payload_size;
         log.good_bytes = static_cast<std::int64_t>(pos);
     }
     if (log.warning.empty() && !log.complete)

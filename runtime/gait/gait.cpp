@@ -27,6 +27,9 @@ float horizontal_distance(vec3 a, vec3 b) {
 }
 // Exponential approach without exp: the fraction min(1, rate·dt) per tick.
 float approach(float value, float target, float rate, float dt) { return value + (target - value) * minf(1.0f, rate * dt); }
+// v limited to [−limit, limit] (limit ≥ 0).
+double clamp_magnitude(double v, double limit) { return v > limit ? limit : (v < -limit ? -limit : v); }
+float clamp_magnitude(float v, float limit) { return v > limit ? limit : (v < -limit ? -limit : v); }
 
 struct HeadingFrame {
     vec3 forward;  // (sin h, 0, cos h)
@@ -320,7 +323,7 @@ Landing predict_landing(const GaitConfig& c, float speed, float commanded, float
     for (int k = 0; k < 1200 && phase_left > 0.0f; ++k) {
         if (!turning) {
             const float dv = commanded - out.end_speed;
-            out.end_speed += dv > max_dv ? max_dv : (dv < -max_dv ? -max_dv : dv);
+            out.end_speed += clamp_magnitude(dv, max_dv);
         }
         out.distance += out.end_speed * dt;
         phase_left -= dt / (2.0f * step_plan(c, out.end_speed, commanded, turning).duration);
@@ -338,7 +341,7 @@ Placement plan_target(const GaitState& g, int foot, vec3 root, float heading, fl
     const float time_to_land = predicted.time;
     const double turn = det::wrap_angle(static_cast<double>(desired_heading) - heading);
     const double max_turn = c.turn_rate_deg_s * det::kDegToRad * time_to_land;
-    const double landing_heading = heading + (turn > max_turn ? max_turn : (turn < -max_turn ? -max_turn : turn));
+    const double landing_heading = heading + clamp_magnitude(turn, max_turn);
     const HeadingFrame now = heading_frame(heading);
     const HeadingFrame then = heading_frame(landing_heading);
     // Mean direction of travel over the swing.
@@ -422,257 +425,435 @@ GaitState initial_gait_state(const GaitConfig& c, const GaitRig& rig, const Terr
     return g;
 }
 
-void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const GaitTickInput& in, const GaitConfig& c,
-                 const GaitRig& rig, const Terrain& terrain) {
-    const float dt = in.dt;
-    // Stick → commanded speed and direction (stick up walks toward −Z).
-    const float deflection = minf(1.0f, std::sqrt(in.stick_x * in.stick_x + in.stick_y * in.stick_y));
-    const float fraction = stick_speed_fraction(deflection, c);
-    const bool moving_command = fraction > 0.0f;
-    float desired_heading = heading;
-    if (moving_command) desired_heading = static_cast<float>(det::atan2(in.stick_x, -in.stick_y));
-    const double diff = det::wrap_angle(static_cast<double>(desired_heading) - heading);
-    const double abs_diff = diff < 0 ? -diff : diff;
+namespace {
 
-    if (moving_command) {
-        const std::int32_t was_turning = g.turning_in_place;
-        if (abs_diff > c.turn_in_place_deg * det::kDegToRad) g.turning_in_place = 1;
-        else if (abs_diff < 20.0 * det::kDegToRad) g.turning_in_place = 0;
-        // Swings aimed for turning in place re-aim for walking off, and back.
-        if (was_turning != g.turning_in_place)
-            for (FootState& f : g.feet) {
-                f.replanned = 0;
-                f.planned_speed = -1.0f;
-            }
-        const double max_turn = c.turn_rate_deg_s * det::kDegToRad * dt;
-        heading = static_cast<float>(det::wrap_angle(heading + (diff > max_turn ? max_turn : (diff < -max_turn ? -max_turn : diff))));
-        g.commanded_speed = c.max_speed * fraction * slope_speed_multiplier(terrain, c, root.x, root.z, heading);
-        if (g.turning_in_place) {
-            g.speed = 0.0f;  // immediate: no walking backwards
-        } else {
-            const float dv = g.commanded_speed - g.speed;
-            const float max_dv = c.acceleration * dt;
-            g.speed += dv > max_dv ? max_dv : (dv < -max_dv ? -max_dv : dv);
+// update_gait's constants (docs/gait.md). The doubles enter double arithmetic
+// (angles), the floats float arithmetic, exactly as the literals did.
+constexpr double kEndTurnInPlaceDeg = 20.0;        // a turn in place ends once the stick is this close to the heading
+constexpr double kStepTurnRad = 0.2;               // a wider turn is stepped even at zero speed; its side picks the lead foot
+constexpr float kForceReaim = -1.0f;               // a planned_speed no command has: the swing re-aims at its next check
+constexpr float kStepsPerCycle = 2.0f;             // a gait cycle is one left and one right step
+constexpr float kRightFootPhase = 0.5f;            // the right foot's cycle phase lags the left's by half a cycle
+constexpr float kMinStopSwingLeftS = 0.02f;        // s: a swing cut short by a stop keeps at least this much
+constexpr float kMaxStopFootSpeed = 3.0f;          // m/s: a foot re-aimed by a stop moves no faster
+constexpr float kMinStopSwingS = 0.15f;            // s: a foot re-aimed by a stop swings at least this long
+constexpr float kRunBlendSpan = 0.6f;              // m/s of speed over which the walk → run blend goes from 0 to 1
+constexpr float kRunBlendAtThreshold = 0.5f;       // the walk/run blend at exactly run_threshold
+constexpr float kMinSwingPhaseShare = 1e-3f;       // least (1 − lift phase) a swing's pace divides by
+constexpr float kReaimSpeedChange = 0.25f;         // m/s: a commanded speed change this large re-aims a swing
+constexpr double kReaimHeadingChangeRad = 0.25;    // rad: a stick direction change this large re-aims a swing
+constexpr float kLatestReaimProgress = 0.6f;       // a swing further along keeps its target
+constexpr float kMinReaimShiftM = 0.06f;           // m: a new target closer than this to the old one is not taken
+constexpr float kStopStaggerM = 0.05f;             // m: feet further apart along the heading close up when stopping
+constexpr float kMinClosingStepS = 0.25f;          // s: the closing step takes at least this long
+constexpr float kClosingStepStretch = 1.5f;        // … and otherwise this many times stop_transition_s
+constexpr float kFullActivitySpeed = 1.0f;         // m/s at which bob and arm swing reach full amplitude
+constexpr float kPelvisBaseRateScale = 1.5f;       // the pelvis base follows the ground this much faster than interpolation_rate
+constexpr float kFullLegReachShare = 0.995f;       // mid-swing the hip may be this share of thigh + shin from the ankle
+constexpr float kMinHipDropShareSq = 0.09f;        // the hip stays at least 0.3 of the reach (squared: 0.09) above the ankle
+constexpr float kMidSwingBump = 4.0f;              // 4·u·(1 − u): 0 at lift-off and landing, 1 mid-swing
+constexpr float kNoLimitM = 1e9f;                  // m: a pelvis height limit that no foot imposes
+
+// The stick's command this tick, measured against the heading before this tick's turn.
+struct StickCommand {
+    float fraction = 0.0f;         // of max_speed, after deadzone and response curve
+    bool moving = false;           // outside the deadzone
+    float desired_heading = 0.0f;  // radians; the current heading when not moving
+    double diff = 0.0;             // desired − current heading, wrapped
+    double abs_diff = 0.0;
+};
+
+// Stick → commanded speed fraction and direction (stick up walks toward −Z).
+StickCommand read_stick(const GaitTickInput& in, const GaitConfig& c, float heading) {
+    StickCommand cmd;
+    const float deflection = minf(1.0f, std::sqrt(in.stick_x * in.stick_x + in.stick_y * in.stick_y));
+    cmd.fraction = stick_speed_fraction(deflection, c);
+    cmd.moving = cmd.fraction > 0.0f;
+    cmd.desired_heading = heading;
+    if (cmd.moving) cmd.desired_heading = static_cast<float>(det::atan2(in.stick_x, -in.stick_y));
+    cmd.diff = det::wrap_angle(static_cast<double>(cmd.desired_heading) - heading);
+    cmd.abs_diff = cmd.diff < 0 ? -cmd.diff : cmd.diff;
+    return cmd;
+}
+
+// Wide reversals turn in place until the stick is close to the heading again
+// (hysteresis); swings aimed for one way of moving re-aim for the other.
+void update_turning_in_place(GaitState& g, double abs_diff, const GaitConfig& c) {
+    const std::int32_t was_turning = g.turning_in_place;
+    if (abs_diff > c.turn_in_place_deg * det::kDegToRad) g.turning_in_place = 1;
+    else if (abs_diff < kEndTurnInPlaceDeg * det::kDegToRad) g.turning_in_place = 0;
+    if (was_turning != g.turning_in_place)
+        for (FootState& f : g.feet) {
+            f.replanned = 0;
+            f.planned_speed = kForceReaim;
         }
-    } else {
+}
+
+// The heading turns toward the stick at turn_rate_deg_s; the speed approaches
+// the command (slowed on slopes along the new heading) at the configured
+// acceleration, and is zero while turning in place. A released stick stops at once.
+void steer(GaitState& g, float& heading, const StickCommand& cmd, vec3 root, const GaitConfig& c, const Terrain& terrain,
+           float dt) {
+    if (!cmd.moving) {
         g.commanded_speed = 0.0f;
         g.speed = 0.0f;  // stopping is immediate in movement
         g.turning_in_place = 0;
+        return;
     }
+    update_turning_in_place(g, cmd.abs_diff, c);
+    const double max_turn = c.turn_rate_deg_s * det::kDegToRad * dt;
+    heading = static_cast<float>(det::wrap_angle(heading + clamp_magnitude(cmd.diff, max_turn)));
+    g.commanded_speed = c.max_speed * cmd.fraction * slope_speed_multiplier(terrain, c, root.x, root.z, heading);
+    if (g.turning_in_place) {
+        g.speed = 0.0f;  // immediate: no walking backwards
+    } else {
+        const float dv = g.commanded_speed - g.speed;
+        const float max_dv = c.acceleration * dt;
+        g.speed += clamp_magnitude(dv, max_dv);
+    }
+}
+
+// The root travels along the (new) heading at the (new) speed.
+HeadingFrame move_root(const GaitState& g, float heading, vec3& root, vec2& velocity, float dt) {
     const HeadingFrame h = heading_frame(heading);
     velocity = vec2(h.forward.x * g.speed, h.forward.z * g.speed);
     root.x += velocity.x * dt;
     root.z += velocity.y * dt;
+    return h;
+}
 
-    const bool wants_steps = moving_command && (g.speed > 0.0f || g.turning_in_place || abs_diff > 0.2);
-    const StepPlan plan = step_plan(c, g.speed, g.commanded_speed, g.turning_in_place != 0);
-    const float dphase = dt / (2.0f * plan.duration);
+// What the phases after steering read: the fixed inputs and what steering decided.
+struct GaitTick {
+    const GaitConfig& c;
+    const GaitRig& rig;
+    const Terrain& terrain;
+    float dt;
+    float heading;          // after this tick's turn
+    float desired_heading;  // the stick's direction
+    HeadingFrame h;         // of `heading`
+    StepPlan plan;          // this tick's step duration and duty
+    float dphase;           // how far the cycle phase moves this tick
+};
 
-    // Mode changes.
-    if (wants_steps && g.mode != GaitMode::stepping) {
-        if (g.mode == GaitMode::idle) {
-            // Lead with the foot on the side of the turn, else the left.
-            const int lead = diff < -0.2 ? 1 : 0;
-            g.cycle_phase = frac((lead == 0 ? 0.0f : 0.5f) + plan.duty);
-            g.first_step = 1;
-        }
-        g.mode = GaitMode::stepping;
-        for (FootState& f : g.feet) f.timed_rate = 0.0f;
-    } else if (!wants_steps && g.mode == GaitMode::stepping) {
-        g.mode = GaitMode::stopping;
-        // A foot in the air re-aims beside the planted one and lands quickly.
-        for (int i = 0; i < 2; ++i) {
-            FootState& f = g.feet[static_cast<std::size_t>(i)];
-            const FootState& other = g.feet[static_cast<std::size_t>(1 - i)];
-            if (!f.swinging) continue;
-            const float remaining = maxf(0.02f, (1.0f - f.progress) * (1.0f - f.lift_phase) * 2.0f * plan.duration);
-            // In a flight phase neither foot is down to stand beside: both go under their hips.
-            const vec3 spot = root + h.left * (side_sign(i) * rig.hip_half_width);
-            const Placement p = other.swinging ? place_foot_on_flat_spot(terrain, rig, spot.x, spot.z, h.forward)
-                                               : stop_target(g, i, heading, rig, terrain);
-            // Short, but never faster than 3 m/s for the foot.
-            const float time = clampf(maxf(remaining, horizontal_distance(f.ankle, p.ankle) / 3.0f), 0.15f, c.stop_transition_s);
-            begin_swing(f, p, terrain, rig, c, g.run_blend, 0.0f, 1.0f / time);
-        }
+// Idle or stopping → stepping. From idle the first step (half length) leads with
+// the foot on the side of the turn, else the left.
+void start_stepping(GaitState& g, const GaitTick& t, double diff) {
+    if (g.mode == GaitMode::idle) {
+        const int lead = diff < -kStepTurnRad ? 1 : 0;
+        g.cycle_phase = frac((lead == 0 ? 0.0f : kRightFootPhase) + t.plan.duty);
+        g.first_step = 1;
     }
+    g.mode = GaitMode::stepping;
+    for (FootState& f : g.feet) f.timed_rate = 0.0f;
+}
 
-    // Advance swings and lift stance feet.
-    const float blend_target = clampf((g.speed - c.run_threshold) / 0.6f + 0.5f, 0.0f, 1.0f);
-    g.run_blend = approach(g.run_blend, blend_target, c.interpolation_rate, dt);
-    if (g.mode == GaitMode::stepping) g.cycle_phase = frac(g.cycle_phase + dphase);
-    // Where foot i, lifting (or re-aiming) at its phase psi, should land.
-    const auto aim = [&](int i, float psi) {
-        if (!g.turning_in_place) return plan_target(g, i, root, heading, desired_heading, c, rig, terrain, 1.0f - psi, dt);
-        // Turning in place: small steps to the hip's spot under the turned heading.
-        const float time_to_land = predict_landing(c, g.speed, g.commanded_speed, 1.0f - psi, true, dt).time;
-        const double turn = det::wrap_angle(static_cast<double>(desired_heading) - heading);
-        // Small steps: a foot turns at most kMaxTurnPerStep per swing.
-        const double max_turn = minf(c.turn_rate_deg_s * time_to_land, kMaxTurnPerStepDeg) * det::kDegToRad;
-        const HeadingFrame then = heading_frame(heading + (turn > max_turn ? max_turn : (turn < -max_turn ? -max_turn : turn)));
-        const vec3 spot = root + then.left * (side_sign(i) * rig.hip_half_width);
-        return place_foot_on_flat_spot(terrain, rig, spot.x, spot.z, then.forward);
-    };
+// Stepping → stopping: a foot in the air re-aims beside the planted one and lands quickly.
+void start_stopping(GaitState& g, const GaitTick& t, vec3 root) {
+    g.mode = GaitMode::stopping;
     for (int i = 0; i < 2; ++i) {
         FootState& f = g.feet[static_cast<std::size_t>(i)];
-        FootState& other = g.feet[static_cast<std::size_t>(1 - i)];
-        if (f.swinging) {
-            const float rate = f.timed_rate > 0.0f ? f.timed_rate * dt
-                                                   : minf(dphase / maxf(1e-3f, 1.0f - f.lift_phase), dt / kShortestSwing);
-            f.progress += rate;
-            if (f.progress >= 1.0f) {
-                land(f, g);
-                g.first_step = 0;
-            } else {
-                // Re-aim once if the stick changed the landing spot a lot.
-                const bool command_changed = std::fabs(g.commanded_speed - f.planned_speed) > 0.25f ||
-                                             std::fabs(det::wrap_angle(static_cast<double>(desired_heading) - f.planned_heading)) > 0.25;
-                if (g.mode == GaitMode::stepping && command_changed && !f.replanned && f.timed_rate == 0.0f && f.progress < 0.6f) {
-                    const float psi = foot_phase(g.cycle_phase, i);
-                    const Placement p = aim(i, psi);
-                    if (horizontal_distance(p.ankle, f.target) > 0.06f) {
-                        const float ground = f.ground;
-                        begin_swing(f, p, terrain, rig, c, g.run_blend, psi, 0.0f);
-                        f.start_ground = ground;
-                        f.replanned = 1;
-                    }
-                    f.planned_speed = g.commanded_speed;
-                    f.planned_heading = desired_heading;
-                }
-                evaluate_swing(f, i, c, rig, g.run_blend, h.left);
-            }
-        } else if (g.mode == GaitMode::stepping) {
-            const float psi = foot_phase(g.cycle_phase, i);
-            const bool walking = !running(c, g.speed);
-            if (psi >= plan.duty && (!walking || !other.swinging)) {
-                begin_swing(f, aim(i, psi), terrain, rig, c, g.run_blend, psi, 0.0f);
-                f.planned_speed = g.commanded_speed;
-                f.planned_heading = desired_heading;
-                evaluate_swing(f, i, c, rig, g.run_blend, h.left);
-            }
-        }
+        const FootState& other = g.feet[static_cast<std::size_t>(1 - i)];
+        if (!f.swinging) continue;
+        const float remaining =
+            maxf(kMinStopSwingLeftS, (1.0f - f.progress) * (1.0f - f.lift_phase) * kStepsPerCycle * t.plan.duration);
+        // In a flight phase neither foot is down to stand beside: both go under their hips.
+        const vec3 spot = root + t.h.left * (side_sign(i) * t.rig.hip_half_width);
+        const Placement p = other.swinging ? place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, t.h.forward)
+                                           : stop_target(g, i, t.heading, t.rig, t.terrain);
+        // Short, but never faster than kMaxStopFootSpeed for the foot.
+        const float time = clampf(maxf(remaining, horizontal_distance(f.ankle, p.ankle) / kMaxStopFootSpeed), kMinStopSwingS,
+                                  t.c.stop_transition_s);
+        begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, 0.0f, 1.0f / time);
     }
-    if (g.mode == GaitMode::stopping && !g.feet[0].swinging && !g.feet[1].swinging) {
-        // Both down: bring the trailing foot beside the other in one step, or rest.
-        const float along = dot3(g.feet[0].ankle - g.feet[1].ankle, h.forward);
-        if (std::fabs(along) > 0.05f) {
-            const int trailing = along < 0.0f ? 0 : 1;
-            const Placement p = stop_target(g, trailing, heading, rig, terrain);
-            begin_swing(g.feet[static_cast<std::size_t>(trailing)], p, terrain, rig, c, g.run_blend, 0.0f, 1.0f / maxf(0.25f, c.stop_transition_s * 1.5f));
-            evaluate_swing(g.feet[static_cast<std::size_t>(trailing)], trailing, c, rig, g.run_blend, h.left);
-        } else {
-            g.mode = GaitMode::idle;
-        }
+}
+
+void change_mode(GaitState& g, const GaitTick& t, vec3 root, bool wants_steps, double diff) {
+    if (wants_steps && g.mode != GaitMode::stepping) start_stepping(g, t, diff);
+    else if (!wants_steps && g.mode == GaitMode::stepping) start_stopping(g, t, root);
+}
+
+// Where foot i, lifting (or re-aiming) at its phase psi, should land.
+Placement aim_swing(const GaitState& g, const GaitTick& t, vec3 root, int i, float psi) {
+    if (!g.turning_in_place)
+        return plan_target(g, i, root, t.heading, t.desired_heading, t.c, t.rig, t.terrain, 1.0f - psi, t.dt);
+    // Turning in place: small steps to the hip's spot under the turned heading.
+    const float time_to_land = predict_landing(t.c, g.speed, g.commanded_speed, 1.0f - psi, true, t.dt).time;
+    const double turn = det::wrap_angle(static_cast<double>(t.desired_heading) - t.heading);
+    // Small steps: a foot turns at most kMaxTurnPerStepDeg per swing.
+    const double max_turn = minf(t.c.turn_rate_deg_s * time_to_land, kMaxTurnPerStepDeg) * det::kDegToRad;
+    const HeadingFrame then = heading_frame(t.heading + clamp_magnitude(turn, max_turn));
+    const vec3 spot = root + then.left * (side_sign(i) * t.rig.hip_half_width);
+    return place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, then.forward);
+}
+
+// A swing re-aims once, early in the swing, if the stick changed the landing spot a lot.
+void reaim_if_command_changed(GaitState& g, const GaitTick& t, vec3 root, int i) {
+    FootState& f = g.feet[static_cast<std::size_t>(i)];
+    const bool command_changed =
+        std::fabs(g.commanded_speed - f.planned_speed) > kReaimSpeedChange ||
+        std::fabs(det::wrap_angle(static_cast<double>(t.desired_heading) - f.planned_heading)) > kReaimHeadingChangeRad;
+    const bool may_reaim = g.mode == GaitMode::stepping && command_changed && !f.replanned && f.timed_rate == 0.0f &&
+                           f.progress < kLatestReaimProgress;
+    if (!may_reaim) return;
+    const float psi = foot_phase(g.cycle_phase, i);
+    const Placement p = aim_swing(g, t, root, i, psi);
+    if (horizontal_distance(p.ankle, f.target) > kMinReaimShiftM) {
+        const float ground = f.ground;
+        begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
+        f.start_ground = ground;
+        f.replanned = 1;
     }
+    f.planned_speed = g.commanded_speed;
+    f.planned_heading = t.desired_heading;
+}
+
+// A swinging foot moves on: at its own rate after a stop, else with the cycle's
+// phase (over what was left of it at lift-off), but never slower than a
+// kShortestSwing swing. It lands at progress 1.
+void advance_swing(GaitState& g, const GaitTick& t, vec3 root, int i) {
+    FootState& f = g.feet[static_cast<std::size_t>(i)];
+    const float rate = f.timed_rate > 0.0f
+                           ? f.timed_rate * t.dt
+                           : minf(t.dphase / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), t.dt / kShortestSwing);
+    f.progress += rate;
+    if (f.progress >= 1.0f) {
+        land(f, g);
+        g.first_step = 0;
+        return;
+    }
+    reaim_if_command_changed(g, t, root, i);
+    evaluate_swing(f, i, t.c, t.rig, g.run_blend, t.h.left);
+}
+
+// A planted foot lifts once its phase passes the duty factor; a walk never has
+// both feet in the air.
+void lift_if_due(GaitState& g, const GaitTick& t, vec3 root, int i) {
+    FootState& f = g.feet[static_cast<std::size_t>(i)];
+    const FootState& other = g.feet[static_cast<std::size_t>(1 - i)];
+    const float psi = foot_phase(g.cycle_phase, i);
+    const bool walking = !running(t.c, g.speed);
+    if (psi >= t.plan.duty && (!walking || !other.swinging)) {
+        begin_swing(f, aim_swing(g, t, root, i, psi), t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
+        f.planned_speed = g.commanded_speed;
+        f.planned_heading = t.desired_heading;
+        evaluate_swing(f, i, t.c, t.rig, g.run_blend, t.h.left);
+    }
+}
+
+// The walk/run blend follows the speed, the cycle advances while stepping, swings
+// advance and stance feet lift.
+void advance_feet(GaitState& g, const GaitTick& t, vec3 root) {
+    const float blend_target = clampf((g.speed - t.c.run_threshold) / kRunBlendSpan + kRunBlendAtThreshold, 0.0f, 1.0f);
+    g.run_blend = approach(g.run_blend, blend_target, t.c.interpolation_rate, t.dt);
+    if (g.mode == GaitMode::stepping) g.cycle_phase = frac(g.cycle_phase + t.dphase);
+    for (int i = 0; i < 2; ++i) {
+        if (g.feet[static_cast<std::size_t>(i)].swinging) advance_swing(g, t, root, i);
+        else if (g.mode == GaitMode::stepping) lift_if_due(g, t, root, i);
+    }
+}
+
+// Stopping with both feet down: the trailing foot steps beside the other in one
+// step, or, when they are already side by side, the gait rests.
+void finish_stopping(GaitState& g, const GaitTick& t) {
+    if (g.mode != GaitMode::stopping || g.feet[0].swinging || g.feet[1].swinging) return;
+    const float along = dot3(g.feet[0].ankle - g.feet[1].ankle, t.h.forward);
+    if (std::fabs(along) > kStopStaggerM) {
+        const int trailing = along < 0.0f ? 0 : 1;
+        FootState& f = g.feet[static_cast<std::size_t>(trailing)];
+        const Placement p = stop_target(g, trailing, t.heading, t.rig, t.terrain);
+        begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, 0.0f,
+                    1.0f / maxf(kMinClosingStepS, t.c.stop_transition_s * kClosingStepStretch));
+        evaluate_swing(f, trailing, t.c, t.rig, g.run_blend, t.h.left);
+    } else {
+        g.mode = GaitMode::idle;
+    }
+}
+
+void count_flight_phases(GaitState& g) {
     const bool flight = g.feet[0].swinging && g.feet[1].swinging;
     if (flight && !g.flight_phases_open) ++g.flight_phases;
     g.flight_phases_open = flight ? 1 : 0;
+}
 
-    // Pelvis: over the root, at the mean foot height plus the configured height,
-    // with the prototype's bob and sway, breathing when still; then lowered where
-    // needed so both ankles stay within the IK's exact reach.
-    g.activity = approach(g.activity, g.mode == GaitMode::idle ? 0.0f : clampf(g.speed / 1.0f, 0.0f, 1.0f), c.interpolation_rate, dt);
+// Activity follows the speed (none when idle); an idle root settles over the
+// middle of the feet; the pelvis base follows the mean ground under the feet.
+void settle_root(GaitState& g, const GaitTick& t, vec3& root) {
+    const float activity_target = g.mode == GaitMode::idle ? 0.0f : clampf(g.speed / kFullActivitySpeed, 0.0f, 1.0f);
+    g.activity = approach(g.activity, activity_target, t.c.interpolation_rate, t.dt);
     if (g.mode == GaitMode::idle) {
-        // Settle over the middle of the feet.
         const vec3 mid = 0.5f * (g.feet[0].ankle + g.feet[1].ankle);
-        root.x = approach(root.x, mid.x, c.interpolation_rate, dt);
-        root.z = approach(root.z, mid.z, c.interpolation_rate, dt);
+        root.x = approach(root.x, mid.x, t.c.interpolation_rate, t.dt);
+        root.z = approach(root.z, mid.z, t.c.interpolation_rate, t.dt);
     }
     const float ground_mean = 0.5f * (g.feet[0].ground + g.feet[1].ground);
-    g.pelvis_base = approach(g.pelvis_base, ground_mean, c.interpolation_rate * 1.5f, dt);
+    g.pelvis_base = approach(g.pelvis_base, ground_mean, t.c.interpolation_rate * kPelvisBaseRateScale, t.dt);
     root.y = g.pelvis_base;
-    const float step_phase = frac(2.0f * g.cycle_phase);
-    const vec3 bob = blended_pelvis(rig, g.run_blend, step_phase) * g.activity;
-    const float stance_side = g.cycle_phase < 0.5f ? 1.0f : -1.0f;  // left foot leads the first half
-    const double breath = det::sin(det::kTwoPi * in.breath_time / c.breath_period_s);
-    vec3 pelvis = root + h.left * (bob.x * stance_side) + h.forward * bob.z;
-    pelvis.y = g.pelvis_base + c.gait_pelvis_height + bob.y + static_cast<float>(breath) * c.breath_amplitude * (1.0f - g.activity);
-    // Planted feet bind exactly (within the IK's exact zone). A swinging foot
-    // binds where it will land, seen from where its hip will be then, and the
-    // pelvis moves toward that height at a bounded vertical speed, so stepping
-    // down lowers it over the swing instead of in the last few ticks; the swing
-    // foot now only has to stay within the full leg (the IK's soft reach).
+}
+
+// The pelvis before the reach limits: over the root, at the pelvis base plus
+// the configured height, with the prototype's bob and sway, breathing when still.
+vec3 unlimited_pelvis(const GaitState& g, const GaitTick& t, vec3 root, float breath_time) {
+    const float step_phase = frac(kStepsPerCycle * g.cycle_phase);
+    const vec3 bob = blended_pelvis(t.rig, g.run_blend, step_phase) * g.activity;
+    const float stance_side = g.cycle_phase < kRightFootPhase ? 1.0f : -1.0f;  // left foot leads the first half
+    const double breath = det::sin(det::kTwoPi * breath_time / t.c.breath_period_s);
+    vec3 pelvis = root + t.h.left * (bob.x * stance_side) + t.h.forward * bob.z;
+    pelvis.y = g.pelvis_base + t.c.gait_pelvis_height + bob.y +
+               static_cast<float>(breath) * t.c.breath_amplitude * (1.0f - g.activity);
+    return pelvis;
+}
+
+// How far below the hip an ankle at squared horizontal distance horizontal2 is,
+// for a squared hip–ankle reach2 (at least 0.3 of the reach).
+float hip_drop(float horizontal2, float reach2) { return std::sqrt(maxf(reach2 - horizontal2, kMinHipDropShareSq * reach2)); }
+
+struct PelvisLimits {
+    float hard = kNoLimitM;  // m: keeps every ankle within its reach now
+    float soft = kNoLimitM;  // m: keeps each swing's landing within the planted reach
+};
+
+// Planted feet bind exactly (within the IK's exact zone). A swinging foot binds
+// where it will land, seen from where its hip will be then (the soft limit, which
+// the pelvis approaches at a bounded vertical speed, so stepping down lowers it
+// over the swing instead of in the last few ticks); the swing foot itself only
+// has to stay within the full leg (the IK's soft reach).
+PelvisLimits pelvis_limits(const GaitState& g, const GaitTick& t, vec3 pelvis) {
+    const GaitRig& rig = t.rig;
     const float reach2 = rig.leg_reach * rig.leg_reach;
-    const float full_reach = 0.995f * (rig.thigh + rig.shin);
-    const auto drop_for = [](float horizontal2, float r2) { return std::sqrt(maxf(r2 - horizontal2, 0.09f * r2)); };
-    float hard_limit = 1e9f;
-    float soft_limit = 1e9f;
+    const float full_reach = kFullLegReachShare * (rig.thigh + rig.shin);
+    PelvisLimits limit;
     for (int i = 0; i < 2; ++i) {
         const FootState& f = g.feet[static_cast<std::size_t>(i)];
-        const vec3 hip = pelvis + h.left * (side_sign(i) * rig.hip_half_width);
+        const vec3 hip = pelvis + t.h.left * (side_sign(i) * rig.hip_half_width);
         const float dx = f.ankle.x - hip.x, dz = f.ankle.z - hip.z;
         if (!f.swinging) {
-            hard_limit = minf(hard_limit, f.ankle.y + drop_for(dx * dx + dz * dz, reach2));
+            limit.hard = minf(limit.hard, f.ankle.y + hip_drop(dx * dx + dz * dz, reach2));
             continue;
         }
         // The planted reach at lift-off and landing, the full leg mid-swing, so
         // neither lifting nor landing changes the limit in one tick.
         const float u = clampf(f.progress, 0.0f, 1.0f);
-        const float swing_reach = rig.leg_reach + (full_reach - rig.leg_reach) * (4.0f * u * (1.0f - u));
-        hard_limit = minf(hard_limit, f.ankle.y + drop_for(dx * dx + dz * dz, swing_reach * swing_reach));
-        const float rate = f.timed_rate > 0.0f ? f.timed_rate
-                                               : minf(dphase / dt / maxf(1e-3f, 1.0f - f.lift_phase), 1.0f / kShortestSwing);
+        const float swing_reach = rig.leg_reach + (full_reach - rig.leg_reach) * (kMidSwingBump * u * (1.0f - u));
+        limit.hard = minf(limit.hard, f.ankle.y + hip_drop(dx * dx + dz * dz, swing_reach * swing_reach));
+        const float rate = f.timed_rate > 0.0f
+                               ? f.timed_rate
+                               : minf(t.dphase / t.dt / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), 1.0f / kShortestSwing);
         const float remaining = maxf(0.0f, 1.0f - f.progress) / rate;
-        const vec3 hip_then = hip + h.forward * (g.speed * remaining);
+        const vec3 hip_then = hip + t.h.forward * (g.speed * remaining);
         const float tx = f.target.x - hip_then.x, tz = f.target.z - hip_then.z;
-        soft_limit = minf(soft_limit, f.target.y + drop_for(tx * tx + tz * tz, reach2));
+        limit.soft = minf(limit.soft, f.target.y + hip_drop(tx * tx + tz * tz, reach2));
     }
+    return limit;
+}
+
+// The pelvis: its unlimited place, lowered to the soft limit at no more than
+// kMaxPelvisVerticalSpeed, and never above the hard limit.
+void place_pelvis(GaitState& g, const GaitTick& t, vec3 root, float breath_time) {
+    vec3 pelvis = unlimited_pelvis(g, t, root, breath_time);
+    const PelvisLimits limit = pelvis_limits(g, t, pelvis);
     const float previous_y = g.pelvis.y;
-    const float max_move = kMaxPelvisVerticalSpeed * dt;
-    pelvis.y = minf(pelvis.y, soft_limit);
+    const float max_move = kMaxPelvisVerticalSpeed * t.dt;
+    pelvis.y = minf(pelvis.y, limit.soft);
     pelvis.y = clampf(pelvis.y, previous_y - max_move, previous_y + max_move);
-    pelvis.y = minf(pelvis.y, hard_limit);
+    pelvis.y = minf(pelvis.y, limit.hard);
     g.pelvis = pelvis;
+}
+
+// The spine leans into the speed, up to max_spine_lean_deg.
+void lean_with_speed(GaitState& g, const GaitConfig& c, float dt) {
     const float lean_target = minf(c.max_spine_lean_deg, c.spine_lean_deg_per_m_s * g.speed) * static_cast<float>(det::kDegToRad);
     g.lean = approach(g.lean, lean_target, c.interpolation_rate, dt);
 }
 
-bool GaitPoseJob::validate() const {
-    const std::size_t n = static_cast<std::size_t>(kPuppetJointCount);
-    return gait && rig && config && parents.size() == n && rest_offsets.size() == n && local_rotations.size() == n &&
-           local_translations.size() == n && model_rotations.size() >= n && model_positions.size() >= n;
+}  // namespace
+
+// One tick in phases: the stick steers the heading and speed and moves the root;
+// the mode follows whether steps are wanted; feet swing, land and lift; a stop
+// closes the stance; the root settles and the pelvis follows the feet.
+void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const GaitTickInput& in, const GaitConfig& c,
+                 const GaitRig& rig, const Terrain& terrain) {
+    const float dt = in.dt;
+    const StickCommand cmd = read_stick(in, c, heading);
+    steer(g, heading, cmd, root, c, terrain, dt);
+    const HeadingFrame h = move_root(g, heading, root, velocity, dt);
+    const bool wants_steps = cmd.moving && (g.speed > 0.0f || g.turning_in_place || cmd.abs_diff > kStepTurnRad);
+    const StepPlan plan = step_plan(c, g.speed, g.commanded_speed, g.turning_in_place != 0);
+    const GaitTick t{c, rig, terrain, dt, heading, cmd.desired_heading, h, plan, dt / (kStepsPerCycle * plan.duration)};
+    change_mode(g, t, root, wants_steps, cmd.diff);
+    advance_feet(g, t, root);
+    finish_stopping(g, t);
+    count_flight_phases(g);
+    settle_root(g, t, root);
+    place_pelvis(g, t, root, in.breath_time);
+    lean_with_speed(g, c, dt);
 }
 
-void GaitPoseJob::run() const {
+namespace {
+bool finite3(vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool positive_length(float metres) { return metres > 0.0f && std::isfinite(metres); }
+
+// Runs an IK job whose inputs GaitPoseJob::validate() vouched for (positive
+// bone lengths, a finite state), so it cannot fail.
+TwoBoneIkResult solve_limb(TwoBoneIkJob ik) {
+    TwoBoneIkResult result;
+    ik.result = &result;
+    expect_job_ran(ik.run());
+    return result;
+}
+}  // namespace
+
+bool GaitPoseJob::validate() const {
+    const std::size_t n = static_cast<std::size_t>(kPuppetJointCount);
+    if (!gait || !rig || !config || parents.size() != n || rest_offsets.size() != n || !pose.has_joints(n) ||
+        !parents_in_topological_order(parents))
+        return false;
+    const GaitRig& r = *rig;
+    return positive_length(r.thigh) && positive_length(r.shin) && positive_length(r.upper_arm) &&
+           positive_length(r.forearm) && std::isfinite(heading) && finite3(gait->pelvis) &&
+           finite3(gait->feet[0].ankle) && finite3(gait->feet[1].ankle);
+}
+
+bool GaitPoseJob::run() const {
+    if (!validate()) return false;
     const GaitState& g = *gait;
     const GaitRig& r = *rig;
     const GaitConfig& c = *config;
-    for (std::size_t j = 0; j < local_rotations.size(); ++j) {
-        local_rotations[j] = quat_identity();
-        local_translations[j] = rest_offsets[j];
+    for (std::size_t j = 0; j < pose.local_rotations.size(); ++j) {
+        pose.local_rotations[j] = quat_identity();
+        pose.local_translations[j] = rest_offsets[j];
     }
     const HeadingFrame h = heading_frame(heading);
     const quat yaw = quat_axis_angle(vec3(0.0f, 1.0f, 0.0f), heading);
-    local_rotations[kPelvis] = yaw;
-    local_translations[kPelvis] = g.pelvis;
+    pose.local_rotations[kPelvis] = yaw;
+    pose.local_translations[kPelvis] = g.pelvis;
     // Spine leans into the motion (spread over three joints), breathes when still;
     // neck and head take back half the lean so the gaze stays level.
     const double breath = det::sin(det::kTwoPi * breath_time / c.breath_period_s) * (1.0f - g.activity);
     const quat spine = quat_axis_angle(vec3(1.0f, 0.0f, 0.0f), g.lean / 3.0f - 0.01 * breath);
-    local_rotations[kSpine1] = spine;
-    local_rotations[kSpine2] = spine;
-    local_rotations[kSpine3] = spine;
+    pose.local_rotations[kSpine1] = spine;
+    pose.local_rotations[kSpine2] = spine;
+    pose.local_rotations[kSpine3] = spine;
     const quat head = quat_axis_angle(vec3(1.0f, 0.0f, 0.0f), -0.25 * g.lean + 0.01 * breath);
-    local_rotations[kNeck] = head;
-    local_rotations[kHead] = head;
+    pose.local_rotations[kNeck] = head;
+    pose.local_rotations[kHead] = head;
 
     // Legs: two-bone IK from each hip to its ankle, knees forward.
     const int thighs[2] = {kThighL, kThighR};
     for (int i = 0; i < 2; ++i) {
         const FootState& f = g.feet[static_cast<std::size_t>(i)];
-        TwoBoneIkInput ik;
+        TwoBoneIkJob ik;
         ik.root = g.pelvis + h.left * (side_sign(i) * r.hip_half_width);
         ik.target = f.ankle;
         ik.pole = h.forward;
         ik.upper_length = r.thigh;
         ik.lower_length = r.shin;
-        const TwoBoneIkResult s = solve_two_bone_ik(ik);
+        const TwoBoneIkResult s = solve_limb(ik);
         const std::size_t thigh = static_cast<std::size_t>(thighs[i]);
-        local_rotations[thigh] = quat_normalize(quat_mul(quat_conjugate(yaw), s.upper_rotation));
-        local_rotations[thigh + 1] = quat_normalize(quat_mul(quat_conjugate(s.upper_rotation), s.lower_rotation));
-        local_rotations[thigh + 2] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), f.rotation));
+        pose.local_rotations[thigh] = quat_normalize(quat_mul(quat_conjugate(yaw), s.upper_rotation));
+        pose.local_rotations[thigh + 1] = quat_normalize(quat_mul(quat_conjugate(s.upper_rotation), s.lower_rotation));
+        pose.local_rotations[thigh + 2] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), f.rotation));
     }
-    LocalToModelJob fk{parents, local_rotations, local_translations, model_rotations, model_positions};
-    fk.run();
+    expect_job_ran(LocalToModelJob{parents, pose.local(), pose.model()}.run());
 
     // Arms: the hands follow the blended hand paths, swinging against the legs;
     // elbows point back.
@@ -680,21 +861,21 @@ void GaitPoseJob::run() const {
     const float hang = 0.95f * (r.upper_arm + r.forearm);
     for (int i = 0; i < 2; ++i) {
         const std::size_t clavicle = static_cast<std::size_t>(clavicles[i]);
-        const vec3 shoulder = model_positions[clavicle + 1];
+        const vec3 shoulder = pose.model_positions[clavicle + 1];
         const HermiteSample hand = blended_hand(r, g.run_blend, foot_phase(g.cycle_phase, i));
         const vec3 rest(0.03f, 0.0f, 0.02f);
         const vec3 offset = lerp(rest, hand.position, g.activity);
-        TwoBoneIkInput ik;
+        TwoBoneIkJob ik;
         ik.root = shoulder;
         ik.target = shoulder + h.left * (side_sign(i) * offset.x) + vec3(0.0f, offset.y - hang, 0.0f) + h.forward * offset.z;
         ik.pole = -h.forward + h.left * (side_sign(i) * 0.3f);
         ik.upper_length = r.upper_arm;
         ik.lower_length = r.forearm;
         ik.hinge_sign = -1.0f;
-        const TwoBoneIkResult s = solve_two_bone_ik(ik);
-        const quat clavicle_rotation = model_rotations[clavicle];
-        local_rotations[clavicle + 1] = quat_normalize(quat_mul(quat_conjugate(clavicle_rotation), s.upper_rotation));
-        local_rotations[clavicle + 2] = quat_normalize(quat_mul(quat_conjugate(s.upper_rotation), s.lower_rotation));
+        const TwoBoneIkResult s = solve_limb(ik);
+        const quat clavicle_rotation = pose.model_rotations[clavicle];
+        pose.local_rotations[clavicle + 1] = quat_normalize(quat_mul(quat_conjugate(clavicle_rotation), s.upper_rotation));
+        pose.local_rotations[clavicle + 2] = quat_normalize(quat_mul(quat_conjugate(s.upper_rotation), s.lower_rotation));
         // The wrist follows the hand path's swing direction: the hand trails the
         // motion (follow-through), tilting against the path's velocity along the
         // heading and sideways, by kWristDrag per metre per cycle; at rest it
@@ -704,7 +885,7 @@ void GaitPoseJob::run() const {
         const vec3 drag = h.forward * (-kWristDrag * v.z) + h.left * (-kWristDrag * side_sign(i) * v.x);
         const vec3 hand_down = normalize3(forearm_down + drag, forearm_down);
         const quat hand_rotation = quat_mul(quat_from_to(forearm_down, hand_down), s.lower_rotation);
-        local_rotations[clavicle + 3] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), hand_rotation));
+        pose.local_rotations[clavicle + 3] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), hand_rotation));
     }
     // Only the arms changed since the full pass (hands are leaves; nothing after
     // them hangs off an arm): redo forward kinematics for those six joints, with
@@ -713,10 +894,11 @@ void GaitPoseJob::run() const {
         for (int j = clavicle + 1; j <= clavicle + 3; ++j) {
             const std::size_t k = static_cast<std::size_t>(j);
             const std::size_t p = static_cast<std::size_t>(parents[k]);
-            const quat parent_rotation = model_rotations[p];
-            model_rotations[k] = quat_mul(parent_rotation, local_rotations[k]);
-            model_positions[k] = model_positions[p] + quat_rotate(parent_rotation, local_translations[k]);
+            const quat parent_rotation = pose.model_rotations[p];
+            pose.model_rotations[k] = quat_mul(parent_rotation, pose.local_rotations[k]);
+            pose.model_positions[k] = pose.model_positions[p] + quat_rotate(parent_rotation, pose.local_translations[k]);
         }
+    return true;
 }
 
 }  // namespace marionette

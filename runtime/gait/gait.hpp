@@ -3,15 +3,16 @@
 // terrain, swing paths fitted from blended walk/run Hermite prototypes, stance
 // feet pinned, pelvis from the feet, two-bone IK for legs and arms.
 //
-// Two jobs, so the pose source can be swapped (the motion graph will offer
+// Two steps, so the pose source can be swapped (the simulation offers
 // procedural gait / motion graph / graph + procedural foot placement):
 //   update_gait()  advances the plan: GaitState(k) + input → GaitState(k+1)
-//   pose_from_gait() turns a GaitState into local and model joint transforms.
+//   GaitPoseJob    turns a GaitState into local and model joint transforms.
 // Both are pure functions of their arguments and never allocate.
 #include <array>
 #include <cstdint>
 #include <span>
 
+#include "runtime/anim/pose_spans.hpp"
 #include "runtime/math/hermite_spline.hpp"
 #include "runtime/gait/gait_config.hpp"
 #include "runtime/ground/terrain.hpp"
@@ -108,6 +109,8 @@ void update_gait(GaitState& gait, vec3& root_position, float& heading, vec2& vel
 
 // The seam: the pose for a gait state. Writes local transforms for the 22-joint
 // puppet and runs forward kinematics into the model spans (sizes = joint count).
+// A job (runtime/anim/pose_spans.hpp): run() returns false, touching nothing,
+// when validate() does.
 struct GaitPoseJob {
     const GaitState* gait = nullptr;
     const GaitRig* rig = nullptr;
@@ -116,13 +119,13 @@ struct GaitPoseJob {
     float breath_time = 0.0f;              // seconds, drives idle breathing
     std::span<const int> parents;
     std::span<const vec3> rest_offsets;
-    std::span<quat> local_rotations;
-    std::span<vec3> local_translations;
-    std::span<quat> model_rotations;
-    std::span<vec3> model_positions;
+    PoseSpans pose;                        // out: locals and their forward kinematics
 
+    // False without a state, rig or config, with spans not of the puppet's joint
+    // count, parents out of order, a bone length that is not positive, or a
+    // state the IK cannot solve (not finite).
     bool validate() const;
-    void run() const;
+    [[nodiscard]] bool run() const;
 };
 
 }  // namespace marionette

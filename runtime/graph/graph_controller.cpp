@@ -111,14 +111,14 @@ double estimate_graph_facing(const MotionGraph& g, int* samples, double* agreeme
 
 GraphController::GraphController(const MotionGraph& graph, const GraphControllerConfig& config)
     : graph_(graph), config_(config), path_search_(graph, config.transition_weight) {
-    const std::string problem = validate_motion_graph(graph);
-    if (!problem.empty()) throw std::invalid_argument("motion graph: " + problem);
+    if (const Outcome valid = validate_motion_graph(graph); !valid.ok())
+        throw std::invalid_argument("motion graph: " + valid.problem());
     if (graph.nodes.empty() || graph.edges.empty()) throw std::invalid_argument("motion graph has no edges");
     for (size_t n = 0; n < graph.nodes.size(); ++n)
         if (graph.out_edges(static_cast<int>(n)).empty())
             throw std::invalid_argument("motion graph node " + std::to_string(n) + " has no way out (prune it)");
     const size_t joints = static_cast<size_t>(graph.joint_count());
-    rot_a_.resize(joints), rot_b_.resize(joints), tra_a_.resize(joints), tra_b_.resize(joints);
+    sample_rotations_.resize(joints), sample_translations_.resize(joints);
     const size_t frames = graph.contacts.size();
     frame_yaw_.resize(frames);
     const int root = root_joint_of(graph);
@@ -187,32 +187,12 @@ double GraphController::root_heading(int node, const PlanarTransform& world) con
     return det::wrap_angle(world.angle + frame_yaw_[frame]);
 }
 
-void GraphController::pose_at(int edge, int index, const PlanarTransform& world, std::span<quat> r, std::span<vec3> t) {
-    const GraphEdge& e = graph_.edges[static_cast<size_t>(edge)];
-    if (index >= e.frames) {
-        // The edge's end: the target node's frame, placed as the edge leaves it.
-        const PlanarTransform after = e.kind == GraphEdgeKind::transition ? compose_planar(world, edge_alignment(e)) : world;
-        const GraphNode& n = graph_.nodes[static_cast<size_t>(e.to)];
-        graph_frame_pose(graph_, graph_.clips[static_cast<size_t>(n.clip)].first_frame + n.frame, after, r, t);
-    } else if (e.kind == GraphEdgeKind::transition) {
-        graph_transition_pose(graph_, e, index, world, r, t);
-    } else {
-        const GraphNode& n = graph_.nodes[static_cast<size_t>(e.from)];
-        graph_frame_pose(graph_, graph_.clips[static_cast<size_t>(n.clip)].first_frame + n.frame + index, world, r, t);
-    }
+GraphSampleJob GraphController::sample_job(const GraphControllerState& s, LocalPoseOutput pose) {
+    return {&graph_, s.edge, s.edge_position, placement(s.world_angle, s.world_dx, s.world_dz),
+            {sample_rotations_, sample_translations_}, pose};
 }
 
-void GraphController::pose(const GraphControllerState& s, std::span<quat> r, std::span<vec3> t) {
-    const PlanarTransform world = placement(s.world_angle, s.world_dx, s.world_dz);
-    const int index = static_cast<int>(s.edge_position);
-    const float u = s.edge_position - static_cast<float>(index);
-    pose_at(s.edge, index, world, std::span<quat>(rot_a_), std::span<vec3>(tra_a_));
-    pose_at(s.edge, index + 1, world, std::span<quat>(rot_b_), std::span<vec3>(tra_b_));
-    for (size_t j = 0; j < rot_a_.size(); ++j) {
-        r[j] = quat_slerp(rot_a_[j], rot_b_[j], u);
-        t[j] = lerp(tra_a_[j], tra_b_[j], u);
-    }
-}
+bool GraphController::pose(const GraphControllerState& s, LocalPoseOutput pose) { return sample_job(s, pose).run(); }
 
 void GraphController::start_edge(GraphControllerState& s, int edge) const {
     s.edge = edge;
@@ -389,8 +369,8 @@ void GraphController::advance_action_search(GraphControllerState& s, int budget)
     path_search_label_ = -1;
 }
 
-void GraphController::step(GraphControllerState& s, const GraphControllerInput& in, std::span<quat> rotations,
-                           std::span<vec3> translations) {
+bool GraphController::step(GraphControllerState& s, const GraphControllerInput& in, LocalPoseOutput pose) {
+    if (!sample_job(s, pose).validate()) return false;
     const float deflection2 = in.stick_x * in.stick_x + in.stick_y * in.stick_y;
     const bool active = deflection2 > 0.01f || in.buttons != 0;
     s.idle_seconds = active ? 0.0f : s.idle_seconds + in.dt;
@@ -444,12 +424,14 @@ void GraphController::step(GraphControllerState& s, const GraphControllerInput& 
         // An unfinished path query starts again from the end of the new edge.
         if (s.mode == GraphMotionMode::find_action) s.action_search_pops = 0;
     }
-    pose(s, rotations, translations);
+    // Cannot fail: the spans were checked above and the state is on an edge again.
+    if (!sample_job(s, pose).run()) return false;
     const GraphEdge& e = graph_.edges[static_cast<size_t>(s.edge)];
     const int index = static_cast<int>(s.edge_position);
     const GraphNode& from = graph_.nodes[static_cast<size_t>(e.from)];
     const size_t frame = static_cast<size_t>(graph_.clips[static_cast<size_t>(from.clip)].first_frame + from.frame + index);
     s.contacts = frame < graph_.contacts.size() ? graph_.contacts[frame] : 0;
+    return true;
 }
 
 }  // namespace marionette

@@ -37,7 +37,9 @@
 #include <span>
 #include <vector>
 
+#include "runtime/anim/pose_spans.hpp"
 #include "runtime/graph/graph_path.hpp"
+#include "runtime/graph/graph_sample.hpp"
 #include "runtime/graph/motion_graph.hpp"
 
 namespace marionette {
@@ -132,12 +134,13 @@ public:
     GraphControllerState initial_state() const;
 
     // One tick: advances, decides, and writes the pose (joint_count entries, graph
-    // units, roots placed in the world). Never allocates.
-    void step(GraphControllerState& state, const GraphControllerInput& input, std::span<quat> rotations,
-              std::span<vec3> translations);
+    // units, roots placed in the world: GraphSampleJob). Never allocates. False,
+    // with the state and the pose untouched, when the pose spans are not
+    // joint_count long or the state is not on an edge of the graph.
+    [[nodiscard]] bool step(GraphControllerState& state, const GraphControllerInput& input, LocalPoseOutput pose);
 
-    // The pose of `state` without advancing.
-    void pose(const GraphControllerState& state, std::span<quat> rotations, std::span<vec3> translations);
+    // The pose of `state` without advancing (false, touching nothing, as for step).
+    [[nodiscard]] bool pose(const GraphControllerState& state, LocalPoseOutput pose);
 
     // Root position (graph units) and facing (radians, facing (sin h, 0, cos h)) at a
     // node under a placement.
@@ -145,7 +148,7 @@ public:
     double root_heading(int node, const PlanarTransform& world) const;
 
 private:
-    void pose_at(int edge, int index, const PlanarTransform& world, std::span<quat> r, std::span<vec3> t);
+    GraphSampleJob sample_job(const GraphControllerState& s, LocalPoseOutput pose);
     void start_edge(GraphControllerState& s, int edge) const;
     int choose_next_edge(GraphControllerState& s);
     void search_start(GraphControllerState& s) const;
@@ -161,8 +164,8 @@ private:
     GraphControllerConfig config_;
     GraphPathSearch path_search_;  // the action query's scratch (see the top of this file)
     std::int32_t path_search_label_ = -1;  // label path_search_ is searching for, −1: none yet
-    std::vector<quat> rot_a_, rot_b_;
-    std::vector<vec3> tra_a_, tra_b_;
+    std::vector<quat> sample_rotations_;  // GraphSampleJob's scratch
+    std::vector<vec3> sample_translations_;
     std::vector<float> frame_yaw_;  // per database frame: facing in clip coordinates
     double facing_offset_ = 0.0;
     // Per node: seconds (path cost) to the nearest node where the root moves at

@@ -31,53 +31,54 @@ void index_edges(MotionGraph& g) {
     for (size_t n = 0; n < g.nodes.size(); ++n) g.edge_begin[n + 1] += g.edge_begin[n];
 }
 
-std::string validate_motion_graph(const MotionGraph& g) {
-    if (std::string e = validate_skeleton(g.skeleton); !e.empty()) return "skeleton: " + e;
+Outcome validate_motion_graph(const MotionGraph& g) {
+    if (Outcome skeleton = validate_skeleton(g.skeleton); !skeleton.ok())
+        return Outcome::failure("skeleton: " + skeleton.problem());
     const size_t joints = static_cast<size_t>(g.joint_count());
-    if (g.animated_translation.size() != joints) return "animated_translation needs one flag per joint";
-    if (!(g.frame_rate > 0.0)) return "frame rate must be positive";
-    if (g.window_frames < 1) return "window must be at least one frame";
-    if (g.labels.size() > static_cast<size_t>(kMaxGraphLabels)) return "more than 32 labels";
+    if (g.animated_translation.size() != joints) return Outcome::failure("animated_translation needs one flag per joint");
+    if (!(g.frame_rate > 0.0)) return Outcome::failure("frame rate must be positive");
+    if (g.window_frames < 1) return Outcome::failure("window must be at least one frame");
+    if (g.labels.size() > static_cast<size_t>(kMaxGraphLabels)) return Outcome::failure("more than 32 labels");
     const size_t frames = g.contacts.size();
     if (g.rotations.size() != frames * joints || g.translations.size() != frames * joints)
-        return "frame arrays do not hold frames × joints entries";
+        return Outcome::failure("frame arrays do not hold frames × joints entries");
     std::int64_t next_first = 0;
     for (const GraphClip& c : g.clips) {
-        if (c.first_frame != next_first || c.frame_count < 1) return "clip '" + c.name + "' frames are not contiguous";
+        if (c.first_frame != next_first || c.frame_count < 1) return Outcome::failure("clip '" + c.name + "' frames are not contiguous");
         next_first += c.frame_count;
     }
-    if (static_cast<size_t>(next_first) != frames) return "clips do not cover the frame arrays";
+    if (static_cast<size_t>(next_first) != frames) return Outcome::failure("clips do not cover the frame arrays");
     for (const GraphNode& n : g.nodes) {
-        if (n.clip < 0 || static_cast<size_t>(n.clip) >= g.clips.size()) return "node with an invalid clip";
-        if (n.frame < 0 || n.frame >= g.clips[static_cast<size_t>(n.clip)].frame_count) return "node frame out of range";
+        if (n.clip < 0 || static_cast<size_t>(n.clip) >= g.clips.size()) return Outcome::failure("node with an invalid clip");
+        if (n.frame < 0 || n.frame >= g.clips[static_cast<size_t>(n.clip)].frame_count) return Outcome::failure("node frame out of range");
     }
-    if (g.edge_begin.size() != g.nodes.size() + 1) return "edge index does not match the nodes";
+    if (g.edge_begin.size() != g.nodes.size() + 1) return Outcome::failure("edge index does not match the nodes");
     for (size_t i = 0; i < g.edges.size(); ++i) {
         const GraphEdge& e = g.edges[i];
         if (e.from < 0 || e.to < 0 || static_cast<size_t>(e.from) >= g.nodes.size() ||
             static_cast<size_t>(e.to) >= g.nodes.size())
-            return "edge " + std::to_string(i) + " names a missing node";
-        if (i > 0 && g.edges[i - 1].from > e.from) return "edges are not sorted by source";
+            return Outcome::failure("edge " + std::to_string(i) + " names a missing node");
+        if (i > 0 && g.edges[i - 1].from > e.from) return Outcome::failure("edges are not sorted by source");
         const GraphNode& a = g.nodes[static_cast<size_t>(e.from)];
         const GraphNode& b = g.nodes[static_cast<size_t>(e.to)];
         if (e.kind == GraphEdgeKind::clip) {
             if (a.clip != b.clip || b.frame <= a.frame || e.frames != b.frame - a.frame)
-                return "clip edge " + std::to_string(i) + " does not run forward inside one clip";
+                return Outcome::failure("clip edge " + std::to_string(i) + " does not run forward inside one clip");
         } else if (e.kind == GraphEdgeKind::transition) {
-            if (e.frames != g.window_frames) return "transition edge " + std::to_string(i) + " is not k frames long";
+            if (e.frames != g.window_frames) return Outcome::failure("transition edge " + std::to_string(i) + " is not k frames long");
             // In 64 bits: a file's window may be up to 2^31 - 1 (an int sum would overflow).
             if (static_cast<std::int64_t>(a.frame) + g.window_frames > g.clips[static_cast<size_t>(a.clip)].frame_count ||
                 b.frame < g.window_frames)
-                return "transition edge " + std::to_string(i) + " runs past its clips";
+                return Outcome::failure("transition edge " + std::to_string(i) + " runs past its clips");
         } else {
-            return "edge " + std::to_string(i) + " has an unknown kind";
+            return Outcome::failure("edge " + std::to_string(i) + " has an unknown kind");
         }
     }
     for (size_t n = 0; n < g.nodes.size(); ++n)
-        if (g.edge_begin[n] > g.edge_begin[n + 1]) return "edge index is not monotonic";
+        if (g.edge_begin[n] > g.edge_begin[n + 1]) return Outcome::failure("edge index is not monotonic");
     if (!g.edge_begin.empty() && static_cast<size_t>(g.edge_begin.back()) != g.edges.size())
-        return "edge index does not cover the edges";
-    return {};
+        return Outcome::failure("edge index does not cover the edges");
+    return Outcome::success();
 }
 
 // ---- serialisation ---------------------------------------------------------------
@@ -341,7 +342,7 @@ MotionGraph deserialize_motion_graph(std::span<const std::uint8_t> bytes, const 
         ++g.edge_begin[static_cast<size_t>(e.from) + 1];
     }
     for (size_t n = 0; n < g.nodes.size(); ++n) g.edge_begin[n + 1] += g.edge_begin[n];
-    if (std::string e = validate_motion_graph(g); !e.empty()) r.fail(0, "inconsistent graph: " + e);
+    if (const Outcome valid = validate_motion_graph(g); !valid.ok()) r.fail(0, "inconsistent graph: " + valid.problem());
     return g;
 }
 

@@ -105,8 +105,8 @@ struct MotionGraph {
 // Sorts edges by source and fills edge_begin. Call after changing nodes/edges.
 void index_edges(MotionGraph& graph);
 
-// Empty when sizes and indices are consistent, otherwise what is wrong.
-std::string validate_motion_graph(const MotionGraph& graph);
+// Ok when sizes and indices are consistent, otherwise what is wrong.
+Outcome validate_motion_graph(const MotionGraph& graph);
 
 // The .mgraph format (docs/motion-graph.md): little-endian, versioned, with an
 // xxHash64 of the payload. deserialize throws ImportError naming `file_name` and

@@ -1,5 +1,7 @@
 #include "runtime/math/det_math.hpp"
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 
 namespace marionette::det {
@@ -9,32 +11,50 @@ namespace {
 constexpr double kPio2Hi = 1.57079632673412561417e+00;
 constexpr double kPio2Lo = 6.07710050650619224932e-11;
 
+// c[0]·x^(N−1) + c[1]·x^(N−2) + ... + c[N−1] by Horner's rule: one multiply
+// then one add per coefficient, in that order (no contraction: exact IEEE steps).
+// Adding a negative coefficient is the same IEEE operation as subtracting its
+// magnitude.
+template <std::size_t N>
+double horner(double x, const std::array<double, N>& c) {
+    double p = c[0];
+    for (std::size_t i = 1; i < N; ++i) p = p * x + c[i];
+    return p;
+}
+
+// (sin r − r) / r³ in powers of r², Taylor terms up to r^17: error < (pi/4)^19/19! ~ 1e-18.
+constexpr std::array<double, 8> kSinTerms = {
+    1.0 / 355687428096000.0,  // 1/17!
+    -1.0 / 1307674368000.0,   // 1/15!
+    1.0 / 6227020800.0,       // 1/13!
+    -1.0 / 39916800.0,        // 1/11!
+    1.0 / 362880.0,           // 1/9!
+    -1.0 / 5040.0,            // 1/7!
+    1.0 / 120.0,              // 1/5!
+    -1.0 / 6.0,               // 1/3!
+};
+
+// (1 − cos r) / r² in powers of r², Taylor terms up to r^18.
+constexpr std::array<double, 9> kCosTerms = {
+    1.0 / 6402373705728000.0,  // 1/18!
+    -1.0 / 20922789888000.0,   // 1/16!
+    1.0 / 87178291200.0,       // 1/14!
+    -1.0 / 479001600.0,        // 1/12!
+    1.0 / 3628800.0,           // 1/10!
+    -1.0 / 40320.0,            // 1/8!
+    1.0 / 720.0,               // 1/6!
+    -1.0 / 24.0,               // 1/4!
+    0.5,                       // 1/2!
+};
+
 double sin_poly(double r) {
     const double r2 = r * r;
-    // Taylor terms up to r^17: error < (pi/4)^19/19! ~ 1e-18.
-    double p = 1.0 / 355687428096000.0;    // 1/17!
-    p = p * r2 - 1.0 / 1307674368000.0;    // 1/15!
-    p = p * r2 + 1.0 / 6227020800.0;       // 1/13!
-    p = p * r2 - 1.0 / 39916800.0;         // 1/11!
-    p = p * r2 + 1.0 / 362880.0;           // 1/9!
-    p = p * r2 - 1.0 / 5040.0;             // 1/7!
-    p = p * r2 + 1.0 / 120.0;              // 1/5!
-    p = p * r2 - 1.0 / 6.0;                // 1/3!
-    return r + r * r2 * p;
+    return r + r * r2 * horner(r2, kSinTerms);
 }
 
 double cos_poly(double r) {
     const double r2 = r * r;
-    double p = 1.0 / 6402373705728000.0;   // 1/18!
-    p = p * r2 - 1.0 / 20922789888000.0;   // 1/16!
-    p = p * r2 + 1.0 / 87178291200.0;      // 1/14!
-    p = p * r2 - 1.0 / 479001600.0;        // 1/12!
-    p = p * r2 + 1.0 / 3628800.0;          // 1/10!
-    p = p * r2 - 1.0 / 40320.0;            // 1/8!
-    p = p * r2 + 1.0 / 720.0;              // 1/6!
-    p = p * r2 - 1.0 / 24.0;               // 1/4!
-    p = p * r2 + 0.5;                      // 1/2!
-    return 1.0 - r2 * p;
+    return 1.0 - r2 * horner(r2, kCosTerms);
 }
 
 // atan on [0, tan(pi/8)] by its Taylor series (alternating, 0.4142^35/35 < 1e-15).

@@ -73,38 +73,13 @@ struct MotionGraphConfig {
     float graph_attract_after_s = 30.0f;          // seconds without input before the attract-mode walk
     float graph_attract_temperature = 1.0f;       // attract walk: edge weight 1 / (1 + cost / temperature)
     std::int32_t graph_attract_seed = 1;          // attract-mode PRNG seed
+    float graph_transition_weight = 1.0f;         // path cost: seconds per unit of transition distance
     // [motion_graph.buttons] button bit → label (runtime/sim/tick_input.hpp kButtonNames order)
     std::array<GraphButtonBinding, kButtonCount> graph_buttons = default_graph_buttons();
 };
 
-// [realtime]: read by `marionette run` only, never by the tick.
-struct RealtimeConfig {
-    // [realtime] `marionette run` thread settings (app/live/realtime.cpp); never read by
-    // the tick. Priority 0 = normal scheduling, 1–99 = SCHED_FIFO; cpu −1 = any.
-    std::int32_t input_priority = 0;
-    std::int32_t simulation_priority = 0;
-    std::int32_t render_priority = 0;
-    std::int32_t input_cpu = -1;
-    std::int32_t simulation_cpu = -1;
-    std::int32_t render_cpu = -1;
-    std::int32_t lock_memory = 0;          // 1: mlockall(MCL_CURRENT | MCL_FUTURE) before the threads start
-};
-
-// [motion_graph]: the offline build's parameters, read by graph builds only.
-struct GraphBuildConfig {
-    // [motion_graph] build parameters and path costs (docs/motion-graph.md)
-    std::int32_t graph_analysis_rate_hz = 30;     // clips are resampled to this rate for the build
-    std::int32_t graph_window_frames = 10;        // k: distance window and transition length
-    std::int32_t graph_neighbourhood_frames = 4;  // local minima over (2h+1)² pairs
-    float graph_threshold_percentile = 5.0f;      // threshold as a percentile of all distances
-    float graph_threshold_absolute = 0.0f;        // > 0: absolute threshold (leg lengths²) instead
-    float graph_bridge_percentile = 90.0f;        // looser percentile for bridges into cut-off clips
-    float graph_contact_height = 0.08f;           // foot contact: height above ground, leg lengths
-    float graph_contact_speed = 0.6f;             // foot contact: speed, leg lengths per second
-    float graph_transition_weight = 1.0f;         // path cost: seconds per unit of transition distance
-};
-
-struct SimConfig : TickConfig, GaitConfig, TerrainConfig, MotionSourceConfig, MotionGraphConfig,
-                   RealtimeConfig, GraphBuildConfig {};
+// Thread settings and graph build parameters are no part of it: the tick never
+// reads them (app/config/app_config.hpp holds them beside a SimConfig).
+struct SimConfig : TickConfig, GaitConfig, TerrainConfig, MotionSourceConfig, MotionGraphConfig {};
 
 }  // namespace marionette

@@ -91,8 +91,10 @@ Simulation::Simulation(const SimConfig& config, const Terrain& terrain) : config
     const Skeleton skeleton = make_puppet_skeleton(config_);
     if (skeleton.joint_count() > kMaxJoints) throw std::invalid_argument("puppet has too many joints");
     idle_clip_ = make_idle_clip(skeleton, config_);
-    walk_clip_ = make_walk_clip(skeleton, config_);
-    clip_data_hash_ = hash_clip(idle_clip_) ^ (hash_clip(walk_clip_) * 0x9E3779B97F4A7C15ull);
+    // The walk clip is built only for this hash, which every input log records:
+    // dropping it refuses every existing log; it goes with the next log-format bump.
+    const Clip walk_clip = make_walk_clip(skeleton, config_);
+    clip_data_hash_ = hash_clip(idle_clip_) ^ (hash_clip(walk_clip) * 0x9E3779B97F4A7C15ull);
     // Tick 0: standing on the terrain at the origin, so even a run of no ticks has a full pose.
     state_.joint_count = skeleton.joint_count();
     rig_ = make_gait_rig(config_);
@@ -113,45 +115,43 @@ std::int32_t resolve_motion_source(const SimConfig& config, bool graph_attached)
     return kSourceGraph;
 }
 
-std::string structural_change(const SimConfig& c, const SimConfig& next) {
-    if (next.tick_rate_hz != c.tick_rate_hz) return "simulation.tick_rate_hz";
+Outcome structure_unchanged(const SimConfig& c, const SimConfig& next) {
+    if (next.tick_rate_hz != c.tick_rate_hz) return Outcome::failure("simulation.tick_rate_hz");
     const float SimConfig::*const structural[] = {
         &SimConfig::pelvis_height, &SimConfig::hip_width, &SimConfig::thigh_length, &SimConfig::shin_length,
         &SimConfig::ankle_height, &SimConfig::foot_length, &SimConfig::toe_length, &SimConfig::spine_length,
         &SimConfig::neck_length, &SimConfig::head_length, &SimConfig::shoulder_width,
         &SimConfig::upper_arm_length, &SimConfig::forearm_length, &SimConfig::hand_length};
     for (auto field : structural)
-        if (next.*field != c.*field) return "puppet (skeleton proportions)";
-    if (!(next.terrain == c.terrain)) return "terrain";
-    return {};
+        if (next.*field != c.*field) return Outcome::failure("puppet (skeleton proportions)");
+    if (!(next.terrain == c.terrain)) return Outcome::failure("terrain");
+    return Outcome::success();
 }
 
-std::string Simulation::retune(const SimConfig& next) {
-    std::string key = structural_change(config_, next);
-    if (!key.empty()) return key;
-    key = motion_source_refusal(next);
-    if (!key.empty()) return key;
+Outcome Simulation::retune(const SimConfig& next) {
+    if (Outcome kept = structure_unchanged(config_, next); !kept.ok()) return kept;
+    if (Outcome allowed = motion_source_allowed(next); !allowed.ok()) return allowed;
     const std::int32_t source = resolve_motion_source(next, graph_ != nullptr);
     const std::int32_t current = state_.motion_source;
     config_ = next;
     rig_ = make_gait_rig(config_);
     if (source != current) begin_source_change(source);
-    return {};
+    return Outcome::success();
 }
 
-std::string Simulation::motion_source_refusal(const SimConfig& next) const {
+Outcome Simulation::motion_source_allowed(const SimConfig& next) const {
     const bool wants_graph =
         next.motion_source == MotionSourceSetting::graph || next.motion_source == MotionSourceSetting::graph_feet;
     if (!graph_ && wants_graph)
-        return "motion.source (no motion graph is attached: start with --graph, or with this source in the configuration)";
+        return Outcome::failure("motion.source (no motion graph is attached: start with --graph, or with this source in the configuration)");
     const std::int32_t source = resolve_motion_source(next, graph_ != nullptr);
     // Without a shared skeleton the puppet never leaves the family (gait or
     // graph) it started in, so comparing with the start is the same as with now.
     if ((source == kSourceGait) == skeleton_from_graph_ && !graph_matches_puppet_ && graph_)
-        return "motion.source (the motion graph's skeleton is not the puppet's, so gait and graph cannot blend)";
+        return Outcome::failure("motion.source (the motion graph's skeleton is not the puppet's, so gait and graph cannot blend)");
     if (source == kSourceGraphFeet && !foot_rig_.valid)
-        return "motion.source (graph_feet: the motion graph names no foot joints with a knee and a hip)";
-    return {};
+        return Outcome::failure("motion.source (graph_feet: the motion graph names no foot joints with a knee and a hip)");
+    return Outcome::success();
 }
 
 void Simulation::use_motion_graph(std::shared_ptr<const MotionGraph> graph, const GraphControllerConfig& config,
@@ -198,14 +198,11 @@ void Simulation::step_graph(const TickInput& input, float dt, Pose& out) {
     in.stick_y = static_cast<float>(input.left_y) / kStickScale;
     in.buttons = input.buttons;
     in.dt = dt;
-    const std::span<quat> local_r(out.local_rotations.data(), n);
-    const std::span<vec3> local_t(out.local_translations.data(), n);
-    if (dt > 0.0f) graph_controller_->step(s.graph, in, local_r, local_t);
-    else graph_controller_->pose(s.graph, local_r, local_t);
+    const PoseSpans pose = out.spans(n);
+    const LocalPoseOutput local{pose.local_rotations, pose.local_translations};
+    expect_job_ran(dt > 0.0f ? graph_controller_->step(s.graph, in, local) : graph_controller_->pose(s.graph, local));
     for (size_t j = 0; j < n; ++j) out.local_translations[j] *= metres_per_unit_;
-    const LocalToModelJob fk{std::span<const int>(graph_->skeleton.parents), local_r, local_t,
-                             std::span<quat>(out.model_rotations.data(), n), std::span<vec3>(out.model_positions.data(), n)};
-    fk.run();
+    expect_job_ran(LocalToModelJob{std::span<const int>(graph_->skeleton.parents), pose.local(), pose.model()}.run());
 }
 
 void Simulation::place_feet(const Pose& clip, float dt, Pose& out) {
@@ -219,11 +216,8 @@ void Simulation::place_feet(const Pose& clip, float dt, Pose& out) {
                                config_.feet_release_s,
                                config_.feet_terrain_rate,
                                std::span<const int>(graph_->skeleton.parents),
-                               std::span<quat>(out.local_rotations.data(), n),
-                               std::span<vec3>(out.local_translations.data(), n),
-                               std::span<quat>(out.model_rotations.data(), n),
-                               std::span<vec3>(out.model_positions.data(), n)};
-    job.run();
+                               out.spans(n)};
+    expect_job_ran(job.run());
 }
 
 void Simulation::pose_gait(Pose& out) const {
@@ -233,14 +227,11 @@ void Simulation::pose_gait(Pose& out) const {
                           &rig_,
                           &config_,
                           state_.gait_root.heading,
-                          state_.idle_time,
+                          state_.breath_time,
                           std::span<const int>(puppet.parents),
                           std::span<const vec3>(puppet.rest_offsets),
-                          std::span<quat>(out.local_rotations.data(), n),
-                          std::span<vec3>(out.local_translations.data(), n),
-                          std::span<quat>(out.model_rotations.data(), n),
-                          std::span<vec3>(out.model_positions.data(), n)};
-    job.run();
+                          out.spans(n)};
+    expect_job_ran(job.run());
 }
 
 void Simulation::step_gait(const TickInput& input, float dt, Pose& out) {
@@ -251,12 +242,12 @@ void Simulation::step_gait(const TickInput& input, float dt, Pose& out) {
     gait_input.stick_x = static_cast<float>(input.left_x) / kStickScale;
     gait_input.stick_y = static_cast<float>(input.left_y) / kStickScale;
     gait_input.dt = dt;
-    gait_input.breath_time = s.idle_time;
+    gait_input.breath_time = s.breath_time;
     update_gait(s.gait, s.gait_root.position, s.gait_root.heading, s.gait_root.velocity, gait_input, c, rig_, terrain_);
     s.locomotion_blend = clampf(s.gait.speed / c.walk_cycle_speed, 0.0f, 1.0f);
     s.walk_phase = s.gait.cycle_phase;
-    s.idle_time += dt;
-    if (s.idle_time >= c.breath_period_s) s.idle_time -= c.breath_period_s;
+    s.breath_time += dt;
+    if (s.breath_time >= c.breath_period_s) s.breath_time -= c.breath_period_s;
     pose_gait(out);
 }
 
@@ -323,10 +314,10 @@ void Simulation::output_blend(const Pose& from, const Pose& to, float weight, fl
         s.local_rotations[j] = quat_slerp(from.local_rotations[j], to.local_rotations[j], weight);
         s.local_translations[j] = lerp(from.local_translations[j], to.local_translations[j], weight);
     }
-    const LocalToModelJob fk{std::span<const int>(skeleton().parents), std::span<const quat>(s.local_rotations.data(), n),
-                             std::span<const vec3>(s.local_translations.data(), n),
-                             std::span<quat>(s.model_rotations.data(), n), std::span<vec3>(s.model_positions.data(), n)};
-    fk.run();
+    const LocalToModelJob fk{std::span<const int>(skeleton().parents),
+                             {std::span<const quat>(s.local_rotations.data(), n), std::span<const vec3>(s.local_translations.data(), n)},
+                             {std::span<quat>(s.model_rotations.data(), n), std::span<vec3>(s.model_positions.data(), n)}};
+    expect_job_ran(fk.run());
     const vec2 before(s.root_position.x, s.root_position.z);
     s.root_position = lerp(p_from, p_to, weight);
     if (dt > 0.0f) s.velocity = (vec2(s.root_position.x, s.root_position.z) - before) / dt;
@@ -353,8 +344,8 @@ void Simulation::begin_source_change(std::int32_t source) {
     } else if (current == kSourceGait) {
         // Re-place the graph's motion so its root is where the puppet is, facing its way.
         const size_t n = static_cast<size_t>(graph_->joint_count());
-        graph_controller_->pose(s.graph, std::span<quat>(blend_pose_.local_rotations.data(), n),
-                                std::span<vec3>(blend_pose_.local_translations.data(), n));
+        const PoseSpans blend = blend_pose_.spans(n);
+        expect_job_ran(graph_controller_->pose(s.graph, {blend.local_rotations, blend.local_translations}));
         const size_t root = static_cast<size_t>(foot_rig_.root);
         const vec3 r = blend_pose_.local_translations[root];
         const double turn = det::wrap_angle(static_cast<double>(s.heading) - graph_heading(blend_pose_.local_rotations[root]));
@@ -410,7 +401,7 @@ std::uint64_t hash_state(const PuppetState& s) {
     XXH64_update(h, triggers, sizeof triggers);
     XXH64_update(h, &s.input.buttons, sizeof s.input.buttons);
     const float scalars[8] = {s.root_position.x, s.root_position.y, s.root_position.z, s.velocity.x,
-                              s.velocity.y, s.heading, s.walk_phase, s.idle_time};
+                              s.velocity.y, s.heading, s.walk_phase, s.breath_time};
     hash_floats(h, scalars, 8);
     hash_floats(h, &s.locomotion_blend, 1);
     hash_gait(h, s.gait);

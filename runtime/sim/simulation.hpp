@@ -8,6 +8,7 @@
 #include <string>
 
 #include "runtime/anim/clip.hpp"
+#include "runtime/errors/outcome.hpp"
 #include "runtime/anim/foot_placement.hpp"
 #include "runtime/gait/gait.hpp"
 #include "runtime/graph/graph_controller.hpp"
@@ -46,9 +47,11 @@ struct PuppetState {
     vec3 root_position{0.0f};          // ground point under the pelvis, world metres
     vec2 velocity{0.0f};               // world XZ, m/s
     float heading = 0.0f;              // radians; facing (sin h, 0, cos h)
-    float walk_phase = 0.0f;           // [0, 1) through the walk cycle
-    float idle_time = 0.0f;            // seconds into the idle clip
-    float locomotion_blend = 0.0f;     // 0 idle … 1 walking
+    // walk_phase and locomotion_blend: only hashed (no pose reads them); removing either changes every state
+    // hash and golden, so they stay until the next hash-format bump.
+    float walk_phase = 0.0f;           // [0, 1): gait.cycle_phase after the last gait tick (hashed only, see above)
+    float breath_time = 0.0f;          // s into the breath period: drives the gait's idle breathing
+    float locomotion_blend = 0.0f;     // 0 standing … 1 at walk_cycle_speed or faster (hashed only, see above)
     GaitState gait{};                  // the spline-IK gait's plan (runtime/gait/gait.hpp)
     std::int32_t motion_source = kSourceGait;  // MotionSource now posing the puppet (the target of a fade)
     std::int32_t graph_attached = 0;   // 1: a motion graph is attached (the fields below are then hashed)
@@ -79,11 +82,11 @@ public:
 
     // Applies a new configuration at the tick boundary (live tuning). Structural
     // settings (tick rate, puppet proportions) cannot change while running: the
-    // call then changes nothing and returns the name of the first such key. A new
+    // call then changes nothing and fails naming the first such key. A new
     // [motion] source starts a cross-fade; it is refused (named as
     // "motion.source …") when it needs a graph and none is attached, or when it
     // crosses between gait and graph and the graph's skeleton is not the puppet's.
-    std::string retune(const SimConfig& config);
+    Outcome retune(const SimConfig& config);
 
     const PuppetState& state() const { return state_; }
     const SimConfig& config() const { return config_; }
@@ -104,10 +107,10 @@ public:
     bool graph_matches_puppet() const { return graph_matches_puppet_; }
     // Metres per graph unit of the attached graph's translations (1 without one).
     double metres_per_unit() const { return metres_per_unit_; }
-    // Why retune would refuse the [motion] source of `next` ("motion.source (…)"),
-    // or "" when it would take it. Reads only what is fixed once the graph is
+    // Ok when retune would take the [motion] source of `next`, otherwise why not
+    // ("motion.source (…)"). Reads only what is fixed once the graph is
     // attached, so another thread may call it while step() runs.
-    std::string motion_source_refusal(const SimConfig& next) const;
+    Outcome motion_source_allowed(const SimConfig& next) const;
     double tick_seconds() const { return 1.0 / config_.tick_rate_hz; }
     // Hash of the clip data the puppet animates, recorded in input logs.
     std::uint64_t clip_data_hash() const { return clip_data_hash_; }
@@ -118,6 +121,11 @@ private:
         std::array<vec3, kMaxJoints> local_translations{};
         std::array<quat, kMaxJoints> model_rotations{};
         std::array<vec3, kMaxJoints> model_positions{};
+        // The first `joints` entries of each array, as the jobs take them.
+        PoseSpans spans(size_t joints) {
+            return {{local_rotations.data(), joints}, {local_translations.data(), joints},
+                    {model_rotations.data(), joints}, {model_positions.data(), joints}};
+        }
     };
     void step_gait(const TickInput& input, float dt, Pose& out);
     void pose_gait(Pose& out) const;
@@ -130,8 +138,7 @@ private:
 
     SimConfig config_;
     Terrain terrain_;
-    Clip idle_clip_;
-    Clip walk_clip_;
+    Clip idle_clip_;                   // its skeleton is the puppet's
     std::uint64_t clip_data_hash_ = 0;
     GaitRig rig_;
     std::shared_ptr<const MotionGraph> graph_;
@@ -148,9 +155,10 @@ private:
 // (`auto` and the graph sources fall back to the gait without one).
 std::int32_t resolve_motion_source(const SimConfig& config, bool graph_attached);
 
-// The first structural setting (one that cannot change while running: tick rate,
-// puppet proportions) that differs between two configurations, or "" when none.
-std::string structural_change(const SimConfig& running, const SimConfig& next);
+// Ok when no structural setting (one that cannot change while running: tick
+// rate, puppet proportions, terrain) differs between two configurations,
+// otherwise a failure naming the first that does.
+Outcome structure_unchanged(const SimConfig& running, const SimConfig& next);
 
 // Sets flush-to-zero / denormals-are-zero on the calling thread, the same way on
 // every thread that simulates (run and replay alike): denormals are slow and a

@@ -8,19 +8,22 @@
 using namespace marionette;
 
 TEST_CASE("the shipped default file gives the built-in defaults", "[config]") {
-    const SimConfig loaded = default_config();
+    const SimConfig loaded = default_config().sim;
     SimConfig builtin;
     // The one deliberate difference: the runtime's default ground is flat, the
     // shipped file walks the demo over the stairs.
     builtin.terrain_name = "stairs";
     builtin.terrain = load_terrain("stairs");
     CHECK(serialize_config(loaded) == serialize_config(builtin));
+    // The parts the tick never reads (not in the effective text) match too.
+    CHECK(default_config().realtime == RealtimeConfig{});
+    CHECK(default_config().graph_build == GraphBuildConfig{});
     // The file in the tree is the one compiled in.
     CHECK(test::read_text_file(test::source_path("config/marionette.toml")) == std::string(default_config_text()));
 }
 
 TEST_CASE("a user file overrides only what it names", "[config]") {
-    const SimConfig c = apply_config_text(default_config(), "[locomotion]\nmax_speed = 2\nturn_rate_deg_s = 90.5\n", "u.toml");
+    const SimConfig c = apply_config_text(default_config(), "[locomotion]\nmax_speed = 2\nturn_rate_deg_s = 90.5\n", "u.toml").sim;
     CHECK(c.max_speed == 2.0f);
     CHECK(c.turn_rate_deg_s == 90.5f);
     CHECK(c.tick_rate_hz == 240);
@@ -52,7 +55,7 @@ TEST_CASE("the effective configuration round-trips bit for bit", "[config]") {
     c.turn_rate_deg_s = 123.456f;
     c.tick_rate_hz = 1000;
     const std::string text = serialize_config(c);
-    const SimConfig back = config_from_text(text, "effective");
+    const SimConfig back = config_from_text(text, "effective").sim;
     CHECK(serialize_config(back) == text);
     CHECK(back.max_speed == c.max_speed);
     CHECK(back.stick_deadzone == c.stick_deadzone);

@@ -27,9 +27,11 @@ std::vector<vec3> model_positions(const Clip& clip, int frame) {
     const size_t J = static_cast<size_t>(clip.joint_count());
     std::vector<quat> mr(J);
     std::vector<vec3> mp(J);
-    LocalToModelJob fk{clip.skeleton.parents, std::span<const quat>(clip.frame_rotations(frame), J),
-                       std::span<const vec3>(clip.frame_translations(frame), J), mr, mp};
-    fk.run();
+    const LocalToModelJob fk{clip.skeleton.parents,
+                             {std::span<const quat>(clip.frame_rotations(frame), J),
+                              std::span<const vec3>(clip.frame_translations(frame), J)},
+                             {mr, mp}};
+    REQUIRE(fk.run());
     return mp;
 }
 
@@ -48,7 +50,7 @@ double max_joint_step(const Clip& clip) {
 }
 
 const DefaultGraphBuild& default_build() {
-    static const DefaultGraphBuild build = build_default_motion_graph_report(SimConfig{});
+    static const DefaultGraphBuild build = build_default_motion_graph_report(SimConfig{}, GraphBuildConfig{});
     return build;
 }
 
@@ -66,8 +68,8 @@ TEST_CASE("default graph: action clips import onto the puppet skeleton and start
         const Clip& clip = clips[i];
         INFO(clip.name);
         CHECK(clip.name == default_action_clip_names()[i]);
-        CHECK(validate_clip(clip).empty());
-        CHECK(offline::skeleton_mismatch(puppet, clip.skeleton).empty());
+        CHECK(validate_clip(clip).ok());
+        CHECK(offline::same_skeleton(puppet, clip.skeleton).ok());
         CHECK(clip.frame_rate == Approx(30.0));
         CHECK(clip.duration() >= 1.0);
         CHECK(clip.duration() <= 3.0);
@@ -108,7 +110,7 @@ TEST_CASE("default graph: the pruned component keeps every label and clip", "[de
 
 TEST_CASE("default graph: two builds serialize to identical bytes", "[default_graph]") {
     const std::vector<std::uint8_t> a = serialize_motion_graph(default_build().output.graph);
-    const std::vector<std::uint8_t> b = serialize_motion_graph(build_default_motion_graph(SimConfig{}));
+    const std::vector<std::uint8_t> b = serialize_motion_graph(build_default_motion_graph(SimConfig{}, GraphBuildConfig{}));
     CHECK(a.size() > 1000);
     CHECK(a == b);
 }
@@ -254,7 +256,7 @@ TEST_CASE("default graph: the tiled search finds exactly the reference's candida
     // are flat to ~1e-8 along the diagonal: a search that rounds more than the
     // reference would pick other minima there (the float sgemm path did); below
     // kDistanceNoiseFloor both count as 0.
-    const offline::GraphBuildParams params = graph_build_params(SimConfig{});
+    const offline::GraphBuildParams params = graph_build_params(GraphBuildConfig{});
     std::vector<Clip> clips = generate_locomotion_clips(SimConfig{}, params.analysis_rate_hz);
     for (Clip& c : default_action_clips()) clips.push_back(std::move(c));
     const offline::LabelRules rules =

@@ -16,7 +16,7 @@ std::size_t bit(Button b) { return static_cast<std::size_t>(b); }
 }  // namespace
 
 TEST_CASE("graph buttons: the shipped file maps the face buttons to the default graph's actions", "[graph_buttons]") {
-    const SimConfig c = default_config();
+    const SimConfig c = default_config().sim;
     CHECK(c.graph_buttons[bit(Button::south)].label == "jump");
     CHECK(c.graph_buttons[bit(Button::east)].label == "wave");
     CHECK(c.graph_buttons[bit(Button::west)].label == "bow");
@@ -28,13 +28,13 @@ TEST_CASE("graph buttons: the shipped file maps the face buttons to the default 
 }
 
 TEST_CASE("graph buttons: a user file remaps buttons and the map round-trips", "[graph_buttons]") {
-    const SimConfig c = apply_config_text(default_config(), "[motion_graph.buttons]\neast = \"\"\ndpad_up = \"wave\"\n", "u.toml");
+    const SimConfig c = apply_config_text(default_config(), "[motion_graph.buttons]\neast = \"\"\ndpad_up = \"wave\"\n", "u.toml").sim;
     CHECK(c.graph_buttons[bit(Button::east)].label.empty());
     CHECK(c.graph_buttons[bit(Button::dpad_up)].label == "wave");
     CHECK(c.graph_buttons[bit(Button::dpad_up)].file == "u.toml");
     CHECK(c.graph_buttons[bit(Button::dpad_up)].line == 3);
     CHECK(c.graph_buttons[bit(Button::south)].label == "jump");  // untouched
-    const SimConfig back = config_from_text(serialize_config(c), "effective");
+    const SimConfig back = config_from_text(serialize_config(c), "effective").sim;
     for (std::size_t b = 0; b < kButtonNames.size(); ++b) CHECK(back.graph_buttons[b].label == c.graph_buttons[b].label);
 }
 
@@ -48,20 +48,20 @@ TEST_CASE("graph buttons: bad keys and values name file, line and key", "[graph_
 TEST_CASE("graph buttons: resolved against the graph's labels", "[graph_buttons]") {
     const MotionGraph g = test::make_locomotion_graph();  // labels walk, idle, wave
     SECTION("the default map plays what the graph has; the rest only warns") {
-        const auto map = resolve_graph_buttons(default_config(), g, "test graph");
+        const auto map = resolve_graph_buttons(default_config().sim, g, "test graph");
         CHECK(map[bit(Button::east)] == g.label_index("wave"));
         CHECK(map[bit(Button::south)] == -1);
         CHECK(map[bit(Button::north)] == -1);
         CHECK(map[bit(Button::dpad_up)] == -1);
     }
     SECTION("a changed key names a label of the graph") {
-        const SimConfig c = apply_config_text(default_config(), "[motion_graph.buttons]\nsouth = \"idle\"\ndpad_left = \"walk\"\n", "u.toml");
+        const SimConfig c = apply_config_text(default_config(), "[motion_graph.buttons]\nsouth = \"idle\"\ndpad_left = \"walk\"\n", "u.toml").sim;
         const auto map = resolve_graph_buttons(c, g, "test graph");
         CHECK(map[bit(Button::south)] == g.label_index("idle"));
         CHECK(map[bit(Button::dpad_left)] == g.label_index("walk"));
     }
     SECTION("a changed key naming a missing label is an error with its file, line and the graph's labels") {
-        const SimConfig c = apply_config_text(default_config(), "[motion_graph.buttons]\n\nright_shoulder = \"dance\"\n", "u.toml");
+        const SimConfig c = apply_config_text(default_config(), "[motion_graph.buttons]\n\nright_shoulder = \"dance\"\n", "u.toml").sim;
         try {
             resolve_graph_buttons(c, g, "test graph");
             FAIL("no error");
@@ -76,7 +76,7 @@ TEST_CASE("graph buttons: resolved against the graph's labels", "[graph_buttons]
         MotionGraph unlabelled = g;
         unlabelled.labels.clear();
         for (GraphClip& clip : unlabelled.clips) clip.label_mask = 0;
-        const auto map = resolve_graph_buttons(default_config(), unlabelled, "unlabelled graph");
+        const auto map = resolve_graph_buttons(default_config().sim, unlabelled, "unlabelled graph");
         for (std::size_t b = 0; b < kButtonNames.size(); ++b) CHECK(map[b] == -1);
     }
 }

@@ -20,7 +20,7 @@ using namespace marionette;
 namespace {
 
 std::shared_ptr<const MotionGraph> default_graph() {
-    static const auto graph = std::make_shared<const MotionGraph>(build_default_motion_graph(SimConfig{}));
+    static const auto graph = std::make_shared<const MotionGraph>(build_default_motion_graph(SimConfig{}, GraphBuildConfig{}));
     return graph;
 }
 
@@ -97,7 +97,7 @@ TEST_CASE("motion sources: a live change cross-fades over crossfade_s without a 
     const vec3 root_before = sim.state().root_position;
     REQUIRE(glm::length(root_before) > 1.0f);  // it walked
 
-    REQUIRE(sim.retune(with_source(config, MotionSourceSetting::graph)).empty());
+    REQUIRE(sim.retune(with_source(config, MotionSourceSetting::graph)).ok());
     CHECK(sim.state().motion_source == kSourceGraph);
     CHECK(sim.state().fade.from == kSourceGait);
     CHECK(sim.state().fade.duration == Approx(0.4f));
@@ -117,7 +117,7 @@ TEST_CASE("motion sources: a live change cross-fades over crossfade_s without a 
 
     StepWatch on_graph;
     for (int k = 0; k < 240 * 2; ++k) on_graph.step(sim, stick(0.0f, -0.6f));
-    REQUIRE(sim.retune(with_source(config, MotionSourceSetting::gait)).empty());
+    REQUIRE(sim.retune(with_source(config, MotionSourceSetting::gait)).ok());
     CHECK(sim.state().motion_source == kSourceGait);
     StepWatch back;
     for (int k = 0; k < 120; ++k) back.step(sim, stick(0.0f, -0.6f));
@@ -136,10 +136,10 @@ TEST_CASE("motion sources: reversing a running fade runs it backwards (no jump)"
     Simulation sim(with_source(config, MotionSourceSetting::gait));
     attach_motion_graph(sim, default_graph());
     for (int k = 0; k < 240; ++k) sim.step(stick(0.3f, -0.5f));
-    REQUIRE(sim.retune(with_source(config, MotionSourceSetting::graph)).empty());
+    REQUIRE(sim.retune(with_source(config, MotionSourceSetting::graph)).ok());
     for (int k = 0; k < 30; ++k) sim.step(stick(0.3f, -0.5f));
     const float elapsed = sim.state().fade.elapsed;
-    REQUIRE(sim.retune(with_source(config, MotionSourceSetting::gait)).empty());
+    REQUIRE(sim.retune(with_source(config, MotionSourceSetting::gait)).ok());
     CHECK(sim.state().motion_source == kSourceGait);
     CHECK(sim.state().fade.from == kSourceGraph);
     CHECK(sim.state().fade.elapsed == Approx(0.5f - elapsed));
@@ -152,12 +152,14 @@ TEST_CASE("motion sources: refusals name motion.source and change nothing", "[mo
     const SimConfig config;
     SECTION("no graph attached") {
         Simulation sim(config);
-        const std::string why = sim.retune(with_source(config, MotionSourceSetting::graph));
+        const Outcome refused = sim.retune(with_source(config, MotionSourceSetting::graph));
+        CHECK_FALSE(refused.ok());
+        const std::string& why = refused.problem();
         CHECK(why.rfind("motion.source", 0) == 0);
         CHECK(why.find("no motion graph") != std::string::npos);
         CHECK(sim.state().motion_source == kSourceGait);
         CHECK(sim.config().motion_source == MotionSourceSetting::automatic);
-        CHECK(sim.motion_source_refusal(with_source(config, MotionSourceSetting::gait)).empty());
+        CHECK(sim.motion_source_allowed(with_source(config, MotionSourceSetting::gait)).ok());
     }
     SECTION("a graph of another skeleton cannot blend with the gait") {
         Simulation sim(config);
@@ -165,11 +167,13 @@ TEST_CASE("motion sources: refusals name motion.source and change nothing", "[mo
         CHECK_FALSE(sim.graph_matches_puppet());
         CHECK(sim.state().motion_source == kSourceGraph);
         CHECK(sim.skeleton().joint_count() == 2);
-        const std::string why = sim.retune(with_source(config, MotionSourceSetting::gait));
+        const Outcome refused = sim.retune(with_source(config, MotionSourceSetting::gait));
+        CHECK_FALSE(refused.ok());
+        const std::string& why = refused.problem();
         CHECK(why.find("skeleton is not the puppet's") != std::string::npos);
         CHECK(sim.state().motion_source == kSourceGraph);
         // It has no legs, so graph_feet is refused too.
-        CHECK(sim.retune(with_source(config, MotionSourceSetting::graph_feet)).find("graph_feet") != std::string::npos);
+        CHECK(sim.retune(with_source(config, MotionSourceSetting::graph_feet)).problem().find("graph_feet") != std::string::npos);
         CHECK_THROWS_AS(
             [&] {
                 Simulation feet(with_source(config, MotionSourceSetting::graph_feet));
@@ -238,7 +242,7 @@ TEST_CASE("motion sources: graph_feet is deterministic and its state is in the h
         Simulation sim(config);
         attach_motion_graph(sim, default_graph());
         for (int k = 0; k < 600; ++k) {
-            if (k == 300) REQUIRE(sim.retune(with_source(config, switch_to)).empty());
+            if (k == 300) REQUIRE(sim.retune(with_source(config, switch_to)).ok());
             sim.step(stick(0.2f, -0.8f));
         }
         return hash_state(sim.state());

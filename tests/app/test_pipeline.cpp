@@ -37,8 +37,9 @@ PipelineOptions virtual_run(const SimConfig& config, InputScript script, std::ui
 }
 }  // namespace
 
-TEST_CASE("unplugging the controller idles the puppet; plugging it back resumes at once", "[pipeline]") {
-    const SimConfig config = default_config();
+// (No ';' in test names: catch_discover_tests splits a name there and neither half runs.)
+TEST_CASE("unplugging the controller idles the puppet, plugging it back resumes at once", "[pipeline]") {
+    const SimConfig config = default_config().sim;
     const StickProgram program = parse_stick_program("hold 6s ly=1 lx=0.25\n", "forward.prog");
     InputScript script = script_from_program(program, kSimulatedControllerHz, {{2.0, 1.5}});
     PipelineOptions o = virtual_run(config, std::move(script), 6 * 240);
@@ -82,7 +83,7 @@ TEST_CASE("unplugging the controller idles the puppet; plugging it back resumes 
 }
 
 TEST_CASE("a log with configuration changes replayed live gives the replay's states", "[pipeline]") {
-    const SimConfig config = default_config();
+    const SimConfig config = default_config().sim;
     SimConfig slow = config;
     slow.max_speed = 1.25f;
     slow.turn_rate_deg_s = 90.0f;
@@ -126,6 +127,86 @@ TEST_CASE("a log with configuration changes replayed live gives the replay's sta
     CHECK(again.config_changes[0].before_tick == 300);
     CHECK(again.ticks == log.ticks);
     for (const std::string& f : {ro.trace_csv, o.trace_file, o.record_file}) std::remove(f.c_str());
+}
+
+namespace {
+// A configuration text in the layout logs had before the thread settings and
+// the graph build keys were split from what the tick reads: [realtime] between
+// [locomotion] and [motion_graph], the build keys first in [motion_graph].
+std::string old_style_config_text(std::string text, int input_priority, int window_frames) {
+    const std::string graph_table = "\n[motion_graph]\n";
+    const size_t at = text.find(graph_table);
+    REQUIRE(at != std::string::npos);
+    text.insert(at + graph_table.size(),
+                "analysis_rate_hz = 30\nwindow_frames = " + std::to_string(window_frames) +
+                    "\nneighbourhood_frames = 4\nthreshold_percentile = 5.0\nthreshold_absolute = 0.0\n"
+                    "bridge_percentile = 90.0\ncontact_height = 0.08\ncontact_speed = 0.6\n");
+    text.insert(at, "\n[realtime]\ninput_priority = " + std::to_string(input_priority) +
+                        "\nsimulation_priority = 0\nrender_priority = 0\ninput_cpu = -1\nsimulation_cpu = -1\n"
+                        "render_cpu = -1\nlock_memory = 0\n");
+    return text;
+}
+
+std::vector<std::uint8_t> log_with_change(const std::string& config_text, const std::string& change_text,
+                                          const SimConfig& config, const std::vector<TickInput>& ticks) {
+    InputLogHeader header;
+    header.tick_rate_hz = static_cast<std::uint32_t>(config.tick_rate_hz);
+    header.clip_data_hash = Simulation(config).clip_data_hash();
+    header.config_text = config_text;
+    std::vector<std::uint8_t> bytes = InputLogEncoder::encode_header(header);
+    InputLogEncoder encoder;
+    for (size_t k = 0; k < ticks.size(); ++k) {
+        if (k == 300) encoder.append_config_change(change_text);
+        encoder.append_tick(ticks[k]);
+        if (encoder.pending_ticks() >= 60) encoder.finish_chunk(bytes);
+    }
+    encoder.append_end();
+    encoder.finish_chunk(bytes);
+    return bytes;
+}
+}  // namespace
+
+TEST_CASE("a recorded log embeds only what the tick reads, older logs with realtime and build keys still replay",
+          "[pipeline][config]") {
+    const SimConfig config = default_config().sim;
+    const StickProgram program = parse_stick_program("circle 3s radius=1 turns=1\n", "c.prog");
+    PipelineOptions o = virtual_run(config, script_from_program(program, kSimulatedControllerHz), 3 * 240);
+    o.record_file = temp_path("tick_keys.mlog");
+    const PipelineResult r = run_pipeline(o);
+    const DecodedInputLog recorded = decode_input_log(read_binary_file(o.record_file), o.record_file);
+    std::remove(o.record_file.c_str());
+    const std::string& text = recorded.header.config_text;
+    CHECK(text == serialize_config(config));
+    CHECK(text.find("[realtime]") == std::string::npos);
+    for (const char* build_key : {"input_priority", "lock_memory", "analysis_rate_hz", "window_frames",
+                                  "neighbourhood_frames", "threshold_percentile", "bridge_percentile", "contact_speed"}) {
+        INFO(build_key);
+        CHECK(text.find(build_key) == std::string::npos);
+    }
+    // The controller's path costs are the tick's: they stay.
+    CHECK(text.find("transition_weight = ") != std::string::npos);
+    CHECK(replay_log(recorded, "recorded", {}).final_hash == r.final_hash);
+
+    // The same run as an older recorder wrote it: thread settings and build keys
+    // in the header and in a change, which also retunes what the tick reads.
+    SimConfig slow = config;
+    slow.max_speed = 1.25f;
+    const std::string old_text = old_style_config_text(text, 80, 12);
+    const std::string old_change = old_style_config_text(serialize_config(slow), 90, 14);
+    const AppConfig read_back = config_from_text(old_text, "old.mlog");
+    CHECK(read_back.realtime.input_priority == 80);          // accepted as written ...
+    CHECK(read_back.graph_build.graph_window_frames == 12);
+    CHECK(serialize_config(read_back.sim) == text);          // ... and not part of the tick's configuration
+    const DecodedInputLog old_log = decode_input_log(log_with_change(old_text, old_change, config, recorded.ticks), "old.mlog");
+    const DecodedInputLog new_log =
+        decode_input_log(log_with_change(text, serialize_config(slow), config, recorded.ticks), "new.mlog");
+    ReplayOptions ro;
+    ro.keep_tick_hashes = true;
+    const ReplayResult old_run = replay_log(old_log, "old.mlog", ro);
+    const ReplayResult new_run = replay_log(new_log, "new.mlog", ro);
+    CHECK(old_run.config_changes == 1);
+    CHECK(old_run.tick_hashes == new_run.tick_hashes);
+    CHECK(old_run.final_hash != r.final_hash);  // the change took effect
 }
 
 TEST_CASE("the frame loop interpolates one tick behind and never past the newest state", "[pipeline]") {

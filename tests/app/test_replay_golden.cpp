@@ -34,7 +34,7 @@ std::vector<std::string> lines_of(const std::string& text) {
 }  // namespace
 
 TEST_CASE("replays of the shipped programs match the committed golden traces", "[golden]") {
-    const SimConfig config = default_config();
+    const SimConfig config = default_config().sim;
     for (const std::string name : {"stand_still", "walk_stop", "circle", "demo", "slow_walk", "fast_walk", "run", "start_stop",
                                    "full_circle", "reversals", "stop_mid_step"}) {
         INFO("program " << name);
@@ -60,7 +60,7 @@ TEST_CASE("replays of the shipped programs match the committed golden traces", "
 }
 
 TEST_CASE("replaying the same log twice gives identical hashes at every tick", "[golden]") {
-    const DecodedInputLog log = decode_input_log(record("builtin:circle", default_config()), "circle");
+    const DecodedInputLog log = decode_input_log(record("builtin:circle", default_config().sim), "circle");
     ReplayOptions options;
     options.keep_tick_hashes = true;
     const ReplayResult a = replay_log(log, "circle", options);
@@ -72,18 +72,18 @@ TEST_CASE("replaying the same log twice gives identical hashes at every tick", "
 }
 
 TEST_CASE("a log recorded with another configuration replays with that configuration", "[golden]") {
-    SimConfig slow = default_config();
+    SimConfig slow = default_config().sim;
     slow.max_speed = 1.0f;
     const DecodedInputLog log = decode_input_log(record("builtin:walk_stop", slow), "slow");
     const ReplayResult slow_run = replay_log(log, "slow", {});
-    const DecodedInputLog normal = decode_input_log(record("builtin:walk_stop", default_config()), "normal");
+    const DecodedInputLog normal = decode_input_log(record("builtin:walk_stop", default_config().sim), "normal");
     const ReplayResult normal_run = replay_log(normal, "normal", {});
     CHECK(slow_run.distance_m < normal_run.distance_m);
     CHECK(slow_run.final_hash != normal_run.final_hash);
 }
 
 TEST_CASE("a log whose clip data differ from this build is refused", "[golden]") {
-    std::vector<std::uint8_t> bytes = record("builtin:stand_still", default_config());
+    std::vector<std::uint8_t> bytes = record("builtin:stand_still", default_config().sim);
     DecodedInputLog log = decode_input_log(bytes, "x");
     log.header.clip_data_hash ^= 1;
     CHECK_THROWS_WITH(replay_log(log, "x.mlog", {}), Catch::Contains("different clip data"));
@@ -121,8 +121,9 @@ std::string source_config(const char* source) { return fmt::format("[motion]\nso
 
 TEST_CASE("replays driven by the default motion graph match the committed golden traces", "[golden][golden_graph]") {
     const bool write = std::getenv("MARIONETTE_WRITE_GOLDEN") != nullptr;
-    SimConfig base = default_config();  // stairs, as shipped
-    const auto graph = std::make_shared<const MotionGraph>(build_default_motion_graph(base));
+    const AppConfig shipped = default_config();
+    SimConfig base = shipped.sim;  // stairs, as shipped
+    const auto graph = std::make_shared<const MotionGraph>(build_default_motion_graph(base, shipped.graph_build));
     const std::vector<std::uint8_t> graph_bytes = serialize_motion_graph(*graph);
     const std::string graph_hash = fmt::format("{:016x}", XXH64(graph_bytes.data(), graph_bytes.size(), 0));
     const std::string hash_path = test::source_path("tests/golden/default_graph.hash");
@@ -141,7 +142,7 @@ TEST_CASE("replays driven by the default motion graph match the committed golden
     };
     for (const GraphGolden& c : cases) {
         INFO("golden " << c.name);
-        SimConfig config = config_from_text(source_config(c.source) + fmt::format("[terrain]\nname = \"{}\"\n", c.terrain), c.name);
+        SimConfig config = config_from_text(source_config(c.source) + fmt::format("[terrain]\nname = \"{}\"\n", c.terrain), c.name).sim;
         // Record: the simulation as the live pipeline runs it, config changes at tick boundaries.
         const StickProgram program = load_program(c.program);
         const std::vector<TickInput> ticks = render_stick_program(program, config.tick_rate_hz);
@@ -158,8 +159,8 @@ TEST_CASE("replays driven by the default motion graph match the committed golden
         for (std::uint64_t k = 0; k < ticks.size(); ++k) {
             if (next_switch < c.switches.size() && c.switches[next_switch].first == k) {
                 const std::string text = source_config(c.switches[next_switch].second);
-                running = apply_config_text(running, text, c.name);
-                REQUIRE(sim.retune(running).empty());
+                running = apply_config_change(running, text, c.name);
+                REQUIRE(sim.retune(running).ok());
                 log.config_changes.push_back({k, serialize_config(running)});
                 ++next_switch;
             }

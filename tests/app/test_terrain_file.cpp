@@ -84,13 +84,13 @@ TEST_CASE("the shipped terrains have the features the gait is tested on", "[terr
 }
 
 TEST_CASE("the configuration names a terrain and carries its data inline", "[terrain][config]") {
-    const SimConfig c = apply_config_text(default_config(), "[terrain]\nname = \"slope\"\n", "u.toml");
+    const SimConfig c = apply_config_text(default_config(), "[terrain]\nname = \"slope\"\n", "u.toml").sim;
     CHECK(c.terrain_name == "slope");
     CHECK(c.terrain == load_terrain("slope"));
     // The effective text alone gives the same ground, with no file to read.
     const std::string text = serialize_config(c);
     CHECK_THAT(text, Catch::Contains("[[terrain.slope]]"));
-    const SimConfig back = config_from_text(text, "log");
+    const SimConfig back = config_from_text(text, "log").sim;
     CHECK(back.terrain == c.terrain);
     CHECK(back.terrain_name == "slope");
     CHECK(serialize_config(back) == text);

@@ -115,7 +115,7 @@ TEST_CASE("the counting allocator sees allocations", "[zero_alloc]") {
 }
 
 TEST_CASE("10 000 ticks and 1 000 frames after warm-up allocate nothing", "[zero_alloc]") {
-    const SimConfig config = default_config();
+    const SimConfig config = default_config().sim;
     SimConfig retuned = config;
     retuned.max_speed = 2.0f;
     // Everything that allocates happens before the counted part, as in run_pipeline.
@@ -176,7 +176,7 @@ TEST_CASE("the pipeline's input, simulation and render threads allocate nothing 
     for (const bool virtual_time : {true, false}) {
         INFO((virtual_time ? "virtual time" : "real time"));
         PipelineOptions o;
-        o.config = default_config();
+        o.config = default_config().sim;
         o.script = script_from_program(load_program("builtin:walk_stop"), kSimulatedControllerHz, {{0.5, 0.25}});
         o.total_ticks = virtual_time ? 1620 : 240;  // the whole program, or one real second
         o.virtual_time = virtual_time;

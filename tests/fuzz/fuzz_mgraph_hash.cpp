@@ -15,7 +15,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (!fuzz::fix_up_mgraph(bytes)) return 0;
     try {
         const MotionGraph g = deserialize_motion_graph(bytes, "fuzz.mgraph");
-        fuzz::fuzz_check(validate_motion_graph(g).empty(), "deserialize accepted an invalid graph");
+        fuzz::fuzz_check(validate_motion_graph(g).ok(), "deserialize accepted an invalid graph");
         // The bytes need not be canonical (any non-zero byte is a true flag), but
         // what serialize writes reads back to the same graph, byte for byte.
         const std::vector<std::uint8_t> once = serialize_motion_graph(g);

@@ -67,8 +67,7 @@ TEST_CASE("evdev under umockdev: input thread reads, survives unplug, picks up a
     InputThreadOptions options;
     options.backend = "evdev";
     options.raw = true;
-    std::string message;
-    REQUIRE(thread.start(ring, options, message));
+    REQUIRE(thread.start(ring, options).ok());
     CHECK(thread.backend_description() == "evdev: chosen on the command line");
     REQUIRE(wait_for([&] { return thread.device_connected(); }, 2.0));
     // Frames: stick, press, release + stick.

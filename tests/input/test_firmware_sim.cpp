@@ -312,12 +312,11 @@ TEST_CASE("input thread, hidraw: an unplugged pad is looked for again and read w
     InputThreadOptions options;
     options.backend = "hidraw";
     options.hid_reopen_interval_ms = 1;
-    options.open_hid = [&](const std::string&, HidFormat& format, std::string& path,
-                           std::string&) -> std::unique_ptr<HidTransport> {
+    options.open_hid = [&](const std::string&, OpenedHidPad& opened) {
         ++opens;
-        if (opens == 2) return nullptr;
-        format = HidFormat::dualsense;
-        path = "sim" + std::to_string(opens);
+        if (opens == 2) return Outcome::failure("unplugged");
+        opened.format = HidFormat::dualsense;
+        opened.path = "sim" + std::to_string(opens);
         // The thread owns what it is handed; a forwarding transport keeps the
         // device alive here so the test can look at it afterwards.
         struct Forward final : HidTransport {
@@ -328,13 +327,13 @@ TEST_CASE("input thread, hidraw: an unplugged pad is looked for again and read w
             int send_feature(std::span<const std::uint8_t> r) override { return d.send_feature(r); }
             int get_feature(std::span<std::uint8_t> b) override { return d.get_feature(b); }
         };
-        handed_out.push_back(std::make_unique<fs::SimHidDevice>(opens == 1 ? first : second, format));
-        return std::make_unique<Forward>(*handed_out.back());
+        handed_out.push_back(std::make_unique<fs::SimHidDevice>(opens == 1 ? first : second, opened.format));
+        opened.transport = std::make_unique<Forward>(*handed_out.back());
+        return Outcome::success();
     };
     static InputRing ring;
     InputThread thread;
-    std::string error;
-    REQUIRE(thread.start(ring, options, error));
+    REQUIRE(thread.start(ring, options).ok());
     // Drain the ring while waiting for every report of both pads (bounded wait:
     // the thread reads as fast as the in-process devices answer).
     int connected_samples = 0, disconnect_markers = 0;
@@ -358,13 +357,10 @@ TEST_CASE("input thread, hidraw: an unplugged pad is looked for again and read w
 TEST_CASE("input thread, hidraw: no pad at start is an error naming why", "[firmware_sim][input]") {
     InputThreadOptions options;
     options.backend = "hidraw";
-    options.open_hid = [](const std::string&, HidFormat&, std::string&, std::string& error) {
-        error = "no supported HID pad found";
-        return std::unique_ptr<HidTransport>();
-    };
+    options.open_hid = [](const std::string&, OpenedHidPad&) { return Outcome::failure("no supported HID pad found"); };
     static InputRing ring;
     InputThread thread;
-    std::string error;
-    CHECK_FALSE(thread.start(ring, options, error));
-    CHECK(error == "no supported HID pad found");
+    const Outcome started = thread.start(ring, options);
+    CHECK_FALSE(started.ok());
+    CHECK(started.problem() == "no supported HID pad found");
 }

@@ -47,7 +47,7 @@ KmsConnector hdmi_monitor() {
 TEST_CASE("KMS takes the first connected connector and its preferred mode", "[render][kms]") {
     const std::vector<KmsConnector> connectors = {{40, "DP-1", false, {}}, laptop_panel(), hdmi_monitor()};
     const KmsChoice c = choose_kms_mode(connectors, {});
-    REQUIRE(c.error.empty());
+    REQUIRE(c.chosen.ok());
     CHECK(c.connector_index == 1);
     CHECK(c.mode_index == 0);
 }
@@ -57,7 +57,7 @@ TEST_CASE("KMS highest_refresh policy takes the fastest mode, ties to the larger
     KmsModeRequest r;
     r.policy = KmsModePolicy::highest_refresh;
     const KmsChoice c = choose_kms_mode(connectors, r);
-    REQUIRE(c.error.empty());
+    REQUIRE(c.chosen.ok());
     CHECK(c.mode_index == 1);  // 1920x1200@144
 
     const std::vector<KmsConnector> tie = {{1, "DP-2", true, {{1280, 720, 120000, false}, {1920, 1080, 120000, false}}}};
@@ -68,7 +68,7 @@ TEST_CASE("KMS without a preferred mode falls back to the largest, then fastest"
     const std::vector<KmsConnector> connectors = {
         {7, "DSI-1", true, {{720, 1280, 60000, false}, {1280, 800, 50000, false}, {1280, 800, 60000, false}}}};
     const KmsChoice c = choose_kms_mode(connectors, {});
-    REQUIRE(c.error.empty());
+    REQUIRE(c.chosen.ok());
     CHECK(c.mode_index == 2);
 }
 
@@ -91,18 +91,18 @@ TEST_CASE("KMS reports what is missing: no display, unknown or unplugged connect
     const std::vector<KmsConnector> none = {{1, "HDMI-A-1", false, {}}, {2, "DP-1", false, {}}};
     KmsChoice c = choose_kms_mode(none, {});
     CHECK(c.connector_index == -1);
-    CHECK(c.error == "no connector has a display connected");
+    CHECK(c.chosen.problem() == "no connector has a display connected");
 
     const std::vector<KmsConnector> two = {{1, "HDMI-A-1", false, {}}, laptop_panel()};
     KmsModeRequest r;
     r.connector = "HDMI-A-1";
-    CHECK(choose_kms_mode(two, r).error == "connector HDMI-A-1 has no display connected");
+    CHECK(choose_kms_mode(two, r).chosen.problem() == "connector HDMI-A-1 has no display connected");
     r.connector = "VGA-1";
-    CHECK(choose_kms_mode(two, r).error == "no connector named VGA-1");
+    CHECK(choose_kms_mode(two, r).chosen.problem() == "no connector named VGA-1");
     r.connector = "eDP-1";
     CHECK(choose_kms_mode(two, r).connector_index == 1);
     r.width = 3840;
     r.height = 2160;
     r.refresh_hz = 60;
-    CHECK(choose_kms_mode(two, r).error == "connector eDP-1 offers no mode 3840x2160@60Hz");
+    CHECK(choose_kms_mode(two, r).chosen.problem() == "connector eDP-1 offers no mode 3840x2160@60Hz");
 }

@@ -39,7 +39,7 @@ struct Replayed {
     float ankle_height = 0.0f;
 };
 Replayed replay_ticks(const std::string& program, std::vector<std::uint64_t> ticks) {
-    const SimConfig config = default_config();
+    const SimConfig config = default_config().sim;
     Simulation sim(config);
     InputLogHeader header;
     header.tick_rate_hz = static_cast<std::uint32_t>(config.tick_rate_hz);

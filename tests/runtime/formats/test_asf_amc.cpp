@@ -25,12 +25,10 @@ ModelPose model_pose(const Clip& clip, int frame) {
     const auto n = static_cast<std::size_t>(clip.joint_count());
     ModelPose pose{std::vector<quat>(n), std::vector<vec3>(n)};
     const LocalToModelJob job{clip.skeleton.parents,
-                              {clip.frame_rotations(frame), n},
-                              {clip.frame_translations(frame), n},
-                              pose.rotations,
-                              pose.positions};
+                              {{clip.frame_rotations(frame), n}, {clip.frame_translations(frame), n}},
+                              {pose.rotations, pose.positions}};
     REQUIRE(job.validate());
-    job.run();
+    REQUIRE(job.run());
     return pose;
 }
 
@@ -323,7 +321,7 @@ TEST_CASE("ASF skeleton of CMU subject 16", "[asf_amc]") {
     if (dir.empty()) return;
     const std::string asf_text = test::read_text_file(dir + "/cmu_amc_16/16.asf");
     const Skeleton sk = import_asf_skeleton(asf_text, "16.asf");
-    REQUIRE(validate_skeleton(sk).empty());
+    REQUIRE(validate_skeleton(sk).ok());
     CHECK(sk.joint_count() == 31);
     CHECK(sk.joint_names[0] == "root");
     CHECK(sk.parents[0] == kNoParent);
@@ -365,7 +363,7 @@ TEST_CASE("every CMU subject 16 AMC clip imports with its frame count", "[asf_am
         CHECK(values == ref.dof_total);
 
         const Clip clip = load_asf_amc_files(asf_path, amc_path);
-        CHECK(validate_clip(clip).empty());
+        CHECK(validate_clip(clip).ok());
         CHECK(clip.name == c.name);
         CHECK(clip.frame_count == expected);
         CHECK(clip.joint_count() == 31);
@@ -445,7 +443,7 @@ TEST_CASE("FK of CMU clips matches the textbook Acclaim formulation", "[asf_amc]
 
 TEST_CASE("FK of a tiny ASF/AMC matches hand-computed positions", "[asf_amc]") {
     const Clip clip = import_tiny(kTinyAsf, kTinyAmc);
-    REQUIRE(validate_clip(clip).empty());
+    REQUIRE(validate_clip(clip).ok());
     CHECK(clip.name == "tiny");
     CHECK(clip.frame_count == 3);
     CHECK(clip.length_unit == 1.0);

@@ -44,7 +44,7 @@ TEST_CASE("the hash covers the state: any change changes it", "[simulation]") {
     s.input.buttons ^= 1;
     CHECK(hash_state(s) != h);
     s = base;
-    s.idle_time += 1e-6f;
+    s.breath_time += 1e-6f;
     CHECK(hash_state(s) != h);
     s = base;
     s.local_rotations[kPuppetJointCount + 3].x = 1.0f;  // past joint_count: not state
@@ -80,15 +80,15 @@ TEST_CASE("retune applies tunables and refuses structural changes", "[simulation
     Simulation sim(config);
     SimConfig faster = config;
     faster.max_speed = 1.0f;
-    CHECK(sim.retune(faster).empty());
+    CHECK(sim.retune(faster).ok());
     for (int k = 0; k < 480; ++k) sim.step(stick(1, 0));
     CHECK(speed_of(sim.state()) == Approx(1.0f));
     SimConfig taller = config;
     taller.thigh_length = 0.5f;
-    CHECK(sim.retune(taller) == "puppet (skeleton proportions)");
+    CHECK(sim.retune(taller).problem() == "puppet (skeleton proportions)");
     SimConfig rate = config;
     rate.tick_rate_hz = 120;
-    CHECK(sim.retune(rate) == "simulation.tick_rate_hz");
+    CHECK(sim.retune(rate).problem() == "simulation.tick_rate_hz");
 }
 
 TEST_CASE("fixed-step driver runs whole ticks and caps catch-up", "[fixed_step]") {

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "runtime/anim/two_bone_ik.hpp"
+#include "tests/alloc_counter.hpp"
 
 using namespace marionette;
 
@@ -13,8 +14,8 @@ float distance(vec3 a, vec3 b) {
 }
 float dot(vec3 a, vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 bool finite(vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-TwoBoneIkInput leg(vec3 target) {
-    TwoBoneIkInput in;
+TwoBoneIkJob leg(vec3 target) {
+    TwoBoneIkJob in;
     in.root = vec3(0.09f, 0.9f, 0.0f);
     in.target = target;
     in.pole = vec3(0, 0, 1);
@@ -22,8 +23,15 @@ TwoBoneIkInput leg(vec3 target) {
     in.lower_length = 0.43f;
     return in;
 }
+// Runs a job the test expects to be valid and returns its result.
+TwoBoneIkResult solve(TwoBoneIkJob in) {
+    TwoBoneIkResult result;
+    in.result = &result;
+    REQUIRE(in.run());
+    return result;
+}
 // The segment frames must carry the bones: −Y of each frame runs root → mid → end.
-void check_frames(const TwoBoneIkInput& in, const TwoBoneIkResult& r) {
+void check_frames(const TwoBoneIkJob& in, const TwoBoneIkResult& r) {
     CHECK(distance(in.root + quat_rotate(r.upper_rotation, vec3(0, -in.upper_length, 0)), r.mid) < 1e-5f);
     CHECK(distance(r.mid + quat_rotate(r.lower_rotation, vec3(0, -in.lower_length, 0)), r.end) < 1e-5f);
     CHECK(distance(quat_rotate(r.upper_rotation, vec3(1, 0, 0)), r.hinge_axis) < 1e-5f);
@@ -31,15 +39,97 @@ void check_frames(const TwoBoneIkInput& in, const TwoBoneIkResult& r) {
 }
 }  // namespace
 
+TEST_CASE("TwoBoneIkJob: bad inputs fail validate() and run() writes nothing", "[ik][job]") {
+    const TwoBoneIkResult sentinel{vec3(7.0f), vec3(8.0f), vec3(9.0f), quat(0.5f, 0.5f, 0.5f, 0.5f),
+                                   quat(0.5f, -0.5f, 0.5f, -0.5f), 42.0f, true};
+    const auto check_refused = [&](TwoBoneIkJob in) {
+        TwoBoneIkResult result = sentinel;
+        if (in.result) in.result = &result;
+        CHECK_FALSE(in.validate());
+        CHECK_FALSE(in.run());
+        CHECK(result.mid == sentinel.mid);
+        CHECK(result.end == sentinel.end);
+        CHECK(result.hinge_axis == sentinel.hinge_axis);
+        CHECK(result.upper_rotation == sentinel.upper_rotation);
+        CHECK(result.lower_rotation == sentinel.lower_rotation);
+        CHECK(result.reach == sentinel.reach);
+        CHECK(result.reached == sentinel.reached);
+    };
+    TwoBoneIkResult unused;
+    TwoBoneIkJob valid = leg(vec3(0.0f));
+    valid.result = &unused;
+    SECTION("no result to write") {
+        TwoBoneIkJob in = valid;
+        in.result = nullptr;
+        check_refused(in);
+    }
+    SECTION("zero or negative bone lengths") {
+        TwoBoneIkJob in = valid;
+        in.upper_length = 0.0f;
+        check_refused(in);
+        in = valid;
+        in.lower_length = -0.43f;
+        check_refused(in);
+    }
+    SECTION("non-finite values") {
+        TwoBoneIkJob in = leg(vec3(NAN, 0.0f, 0.0f));
+        in.result = &unused;
+        check_refused(in);
+        in = valid;
+        in.root.y = INFINITY;
+        check_refused(in);
+        in = valid;
+        in.pole.z = NAN;
+        check_refused(in);
+        in = valid;
+        in.upper_length = INFINITY;
+        check_refused(in);
+    }
+    SECTION("soft reach outside (0, 1], negative fold margin") {
+        TwoBoneIkJob in = valid;
+        in.soft_reach_start = 0.0f;
+        check_refused(in);
+        in = valid;
+        in.soft_reach_start = 1.5f;
+        check_refused(in);
+        in = valid;
+        in.min_reach_margin = -1e-3f;
+        check_refused(in);
+    }
+    SECTION("valid inputs run and write the result") {
+        TwoBoneIkResult result = sentinel;
+        TwoBoneIkJob in = valid;
+        in.result = &result;
+        CHECK(in.validate());
+        CHECK(in.run());
+        CHECK(result.reach != sentinel.reach);
+        CHECK(finite(result.mid));
+    }
+}
+
+TEST_CASE("TwoBoneIkJob::run never allocates", "[ik][job]") {
+    TwoBoneIkResult result;
+    TwoBoneIkJob in = leg(vec3(0.09f, 0.3f, 0.1f));
+    in.result = &result;
+    int refused = 0;
+    const std::uint64_t before = test::allocation_count();
+    for (int i = 0; i < 100; ++i) {
+        in.target.z = 0.001f * static_cast<float>(i);
+        if (!in.run()) ++refused;
+    }
+    CHECK(test::allocation_count() == before);
+    CHECK(refused == 0);
+}
+
 TEST_CASE("two-bone IK reaches every reachable target within 0.1 mm with bone lengths kept", "[ik]") {
     int solved = 0;
     for (float x = -0.4f; x <= 0.4f; x += 0.1f)
         for (float y = 0.0f; y <= 0.8f; y += 0.1f)
             for (float z = -0.5f; z <= 0.5f; z += 0.1f) {
-                const TwoBoneIkInput in = leg(vec3(0.09f + x, y, z));
+                const TwoBoneIkJob in = leg(vec3(0.09f + x, y, z));
                 const float d = distance(in.root, in.target);
                 if (d > in.soft_reach_start * 0.87f || d < 0.02f) continue;
-                const TwoBoneIkResult r = solve_two_bone_ik(in);
+                const TwoBoneIkResult r = solve(in);
                 INFO("target " << in.target.x << " " << in.target.y << " " << in.target.z);
                 REQUIRE(distance(r.end, in.target) <= 1e-4f);
                 CHECK(r.reached);
@@ -52,31 +142,31 @@ TEST_CASE("two-bone IK reaches every reachable target within 0.1 mm with bone le
 }
 
 TEST_CASE("two-bone IK bends toward the pole: knees forward, elbows back", "[ik]") {
-    TwoBoneIkInput knee = leg(vec3(0.09f, 0.2f, 0.1f));
-    const TwoBoneIkResult r = solve_two_bone_ik(knee);
+    TwoBoneIkJob knee = leg(vec3(0.09f, 0.2f, 0.1f));
+    const TwoBoneIkResult r = solve(knee);
     // The knee lies ahead (+Z) of the hip–ankle line.
     const vec3 line = (knee.target - knee.root) / distance(knee.target, knee.root);
     const vec3 offset = (r.mid - knee.root) - line * dot(r.mid - knee.root, line);
     CHECK(offset.z > 0.05f);
     CHECK(std::abs(offset.x) < 1e-5f);
-    TwoBoneIkInput elbow = knee;
+    TwoBoneIkJob elbow = knee;
     elbow.pole = vec3(0, 0, -1);
-    const TwoBoneIkResult e = solve_two_bone_ik(elbow);
+    const TwoBoneIkResult e = solve(elbow);
     const vec3 elbow_offset = (e.mid - elbow.root) - line * dot(e.mid - elbow.root, line);
     CHECK(elbow_offset.z < -0.05f);
     CHECK(distance(e.end, elbow.target) < 1e-4f);
 }
 
 TEST_CASE("a straight limb gets the rest frame for either hinge sign", "[ik]") {
-    TwoBoneIkInput in = leg(vec3(0.09f, 0.9f - 0.87f * 0.5f, 0.0f));
+    TwoBoneIkJob in = leg(vec3(0.09f, 0.9f - 0.87f * 0.5f, 0.0f));
     in.soft_reach_start = 1.0f;
     in.target = vec3(0.09f, 0.9f - 0.87f, 0.0f);  // exactly full extension, straight down
-    const TwoBoneIkResult r = solve_two_bone_ik(in);
+    const TwoBoneIkResult r = solve(in);
     CHECK(std::abs(r.upper_rotation.w) == Approx(1.0f).margin(1e-4));
     CHECK(std::abs(r.lower_rotation.w) == Approx(1.0f).margin(1e-4));
     in.pole = vec3(0, 0, -1);
     in.hinge_sign = -1.0f;
-    const TwoBoneIkResult arm = solve_two_bone_ik(in);
+    const TwoBoneIkResult arm = solve(in);
     CHECK(std::abs(arm.upper_rotation.w) == Approx(1.0f).margin(1e-4));
     CHECK(distance(arm.hinge_axis, vec3(1, 0, 0)) < 1e-5f);
 }
@@ -86,8 +176,8 @@ TEST_CASE("out-of-reach targets are approached softly, never snapped", "[ik]") {
     float previous_reach = 0.0f;
     vec3 previous_mid(0.0f);
     for (float d = 0.80f; d <= 1.40f; d += 0.002f) {
-        TwoBoneIkInput in = leg(vec3(0.09f, 0.9f - d * 0.8f, d * 0.6f));
-        const TwoBoneIkResult r = solve_two_bone_ik(in);
+        TwoBoneIkJob in = leg(vec3(0.09f, 0.9f - d * 0.8f, d * 0.6f));
+        const TwoBoneIkResult r = solve(in);
         CHECK(r.reach < full);
         CHECK(r.reach >= previous_reach);
         CHECK(finite(r.mid));
@@ -108,8 +198,8 @@ TEST_CASE("out-of-reach targets are approached softly, never snapped", "[ik]") {
 
 TEST_CASE("degenerate IK inputs give finite poses with the bone lengths kept", "[ik]") {
     SECTION("target on the root") {
-        TwoBoneIkInput in = leg(vec3(0.09f, 0.9f, 0.0f));
-        const TwoBoneIkResult r = solve_two_bone_ik(in);
+        TwoBoneIkJob in = leg(vec3(0.09f, 0.9f, 0.0f));
+        const TwoBoneIkResult r = solve(in);
         CHECK(finite(r.mid));
         CHECK(finite(r.end));
         CHECK(distance(in.root, r.mid) == Approx(0.44f).margin(1e-5));
@@ -117,32 +207,24 @@ TEST_CASE("degenerate IK inputs give finite poses with the bone lengths kept", "
         check_frames(in, r);
     }
     SECTION("pole parallel to the limb") {
-        TwoBoneIkInput in = leg(vec3(0.09f, 0.4f, 0.0f));
+        TwoBoneIkJob in = leg(vec3(0.09f, 0.4f, 0.0f));
         in.pole = vec3(0, -1, 0);
-        const TwoBoneIkResult r = solve_two_bone_ik(in);
+        const TwoBoneIkResult r = solve(in);
         CHECK(distance(r.end, in.target) < 1e-4f);
         check_frames(in, r);
     }
     SECTION("zero pole") {
-        TwoBoneIkInput in = leg(vec3(0.09f, 0.4f, 0.1f));
+        TwoBoneIkJob in = leg(vec3(0.09f, 0.4f, 0.1f));
         in.pole = vec3(0.0f);
-        const TwoBoneIkResult r = solve_two_bone_ik(in);
+        const TwoBoneIkResult r = solve(in);
         CHECK(distance(r.end, in.target) < 1e-4f);
     }
     SECTION("equal bones folded onto the root") {
-        TwoBoneIkInput in = leg(vec3(0.09f, 0.9f, 0.0f));
+        TwoBoneIkJob in = leg(vec3(0.09f, 0.9f, 0.0f));
         in.lower_length = in.upper_length;
-        const TwoBoneIkResult r = solve_two_bone_ik(in);
+        const TwoBoneIkResult r = solve(in);
         CHECK(finite(r.mid));
         CHECK(distance(in.root, r.mid) == Approx(0.44f).margin(1e-4));
-    }
-    SECTION("validate rejects zero-length bones and non-finite values") {
-        TwoBoneIkInput in = leg(vec3(0.0f));
-        CHECK(in.validate());
-        in.upper_length = 0.0f;
-        CHECK_FALSE(in.validate());
-        in = leg(vec3(NAN, 0.0f, 0.0f));
-        CHECK_FALSE(in.validate());
     }
 }
 

@@ -1,0 +1,175 @@
+// FootPlacementJob (runtime/anim/foot_placement.hpp): feet pinned and stood on
+// the terrain over a clip pose, as a job.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include "runtime/anim/foot_placement.hpp"
+#include "runtime/anim/skeleton.hpp"
+#include "tests/alloc_counter.hpp"
+#include "tests/job_sentinel.hpp"
+
+using namespace marionette;
+
+namespace {
+// Pelvis, then each leg hip → knee → ankle: thigh 0.45 m, shin 0.43 m.
+constexpr int kLeftAnkle = 3, kRightAnkle = 6;
+constexpr std::uint8_t kBothFeetInContact = 3;  // contact bits: 1 left, 2 right
+const std::vector<int> kLegParents = {kNoParent, 0, 1, 2, 0, 4, 5};
+
+// The clip pose: knees bent (so the IK can reach a target straight below the
+// clip's ankle exactly), with its forward kinematics.
+struct ClipPose {
+    std::vector<quat> local_rotations = std::vector<quat>(7, quat_identity());
+    std::vector<vec3> local_translations = {vec3(0.0f, 0.9f, 0.0f),   vec3(0.1f, 0.0f, 0.0f),  vec3(0.0f, -0.45f, 0.0f),
+                                            vec3(0.0f, -0.43f, 0.0f), vec3(-0.1f, 0.0f, 0.0f), vec3(0.0f, -0.45f, 0.0f),
+                                            vec3(0.0f, -0.43f, 0.0f)};
+    std::vector<quat> model_rotations = std::vector<quat>(7);
+    std::vector<vec3> model_positions = std::vector<vec3>(7);
+    ClipPose() {
+        for (const int hip : {1, 4}) {
+            local_rotations[static_cast<size_t>(hip)] = quat_axis_angle(vec3(1.0f, 0.0f, 0.0f), -0.3);
+            local_rotations[static_cast<size_t>(hip) + 1] = quat_axis_angle(vec3(1.0f, 0.0f, 0.0f), 0.6);
+        }
+        REQUIRE(LocalToModelJob{kLegParents, {local_rotations, local_translations}, {model_rotations, model_positions}}.run());
+    }
+    PoseSpans spans() { return {local_rotations, local_translations, model_rotations, model_positions}; }
+};
+
+Terrain raised_ground(float top) {
+    Terrain t;
+    t.boxes.push_back({-5.0f, -5.0f, 5.0f, 5.0f, top});
+    return t;
+}
+
+bool same_bytes(const FootPlacementState& a, const FootPlacementState& b) {
+    return std::memcmp(&a, &b, sizeof a) == 0;
+}
+}  // namespace
+
+TEST_CASE("FootPlacementJob: bad inputs fail validate() and run() writes nothing", "[foot_placement][job]") {
+    const FootPlacementRig rig = make_foot_placement_rig(kLegParents, kLeftAnkle, kRightAnkle);
+    REQUIRE(rig.valid);
+    const Terrain flat;
+    FootPlacementState state;
+    state.body_offset = 0.125f;  // a state the job would change
+    const FootPlacementState state_before = state;
+    test::SentinelPose out(7);
+    FootPlacementJob valid{&state, &rig, &flat, kBothFeetInContact, 0.01f, 0.15f, 10.0f, kLegParents, out.spans()};
+    const auto check_refused = [&](const FootPlacementJob& job) {
+        CHECK_FALSE(job.validate());
+        CHECK_FALSE(job.run());
+        CHECK(out.untouched());
+        CHECK(same_bytes(state, state_before));
+    };
+    SECTION("null state, rig or terrain") {
+        FootPlacementJob job = valid;
+        job.state = nullptr;
+        check_refused(job);
+        job = valid;
+        job.rig = nullptr;
+        check_refused(job);
+        job = valid;
+        job.terrain = nullptr;
+        check_refused(job);
+    }
+    SECTION("a rig without legs, or with joints off the skeleton") {
+        FootPlacementRig no_legs = make_foot_placement_rig(kLegParents, kLeftAnkle, 99);
+        CHECK_FALSE(no_legs.valid);
+        FootPlacementJob job = valid;
+        job.rig = &no_legs;
+        check_refused(job);
+        FootPlacementRig off = rig;
+        off.legs[1].ankle = 7;
+        job.rig = &off;
+        check_refused(job);
+        off = rig;
+        off.legs[0].hip = -1;
+        check_refused(job);
+        off = rig;
+        off.root = 12;
+        check_refused(job);
+    }
+    SECTION("negative or non-finite time and rates") {
+        FootPlacementJob job = valid;
+        job.dt = -0.01f;
+        check_refused(job);
+        job.dt = NAN;
+        check_refused(job);
+        job = valid;
+        job.release_s = -1.0f;
+        check_refused(job);
+        job = valid;
+        job.terrain_rate = 0.0f;
+        check_refused(job);
+    }
+    SECTION("spans not of the skeleton's size") {
+        test::SentinelPose short_pose(6);
+        FootPlacementJob job = valid;
+        for (int span = 0; span < 4; ++span) {
+            PoseSpans p = out.spans();
+            if (span == 0) p.local_rotations = short_pose.local_rotations;
+            if (span == 1) p.local_translations = short_pose.local_translations;
+            if (span == 2) p.model_rotations = short_pose.model_rotations;
+            if (span == 3) p.model_positions = short_pose.model_positions;
+            job.pose = p;
+            check_refused(job);
+        }
+        CHECK(short_pose.untouched());
+    }
+    SECTION("parents not before their children") {
+        const std::vector<int> out_of_order = {kNoParent, 0, 1, 2, 0, 6, 5};
+        FootPlacementJob job = valid;
+        job.parents = out_of_order;
+        check_refused(job);
+    }
+    SECTION("valid inputs run and start the placement") {
+        ClipPose clip;
+        FootPlacementJob job = valid;
+        job.pose = clip.spans();
+        CHECK(job.validate());
+        CHECK(job.run());
+        CHECK(state.started == 1);
+    }
+}
+
+TEST_CASE("FootPlacementJob raises the body to the ground and keeps the legs' lengths", "[foot_placement][job]") {
+    const FootPlacementRig rig = make_foot_placement_rig(kLegParents, kLeftAnkle, kRightAnkle);
+    const Terrain step = raised_ground(0.2f);
+    FootPlacementState state;
+    ClipPose clip;
+    const vec3 clip_left_ankle = clip.model_positions[kLeftAnkle];
+    const FootPlacementJob job{&state, &rig, &step, kBothFeetInContact, 0.0f, 0.15f, 10.0f,
+                               kLegParents, clip.spans()};
+    REQUIRE(job.run());
+    CHECK(state.body_offset == Approx(0.2f));
+    CHECK(clip.local_translations[0].y == Approx(1.1f));
+    CHECK(clip.model_positions[kLeftAnkle].y == Approx(clip_left_ankle.y + 0.2f).margin(1e-4));
+    for (const FootPin& foot : state.feet) CHECK(foot.contact == 1);
+    const auto length = [](vec3 v) { return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z); };
+    CHECK(length(clip.model_positions[2] - clip.model_positions[1]) == Approx(0.45f).margin(1e-5));
+    CHECK(length(clip.model_positions[3] - clip.model_positions[2]) == Approx(0.43f).margin(1e-5));
+}
+
+TEST_CASE("FootPlacementJob::run never allocates", "[foot_placement][job]") {
+    const FootPlacementRig rig = make_foot_placement_rig(kLegParents, kLeftAnkle, kRightAnkle);
+    const Terrain step = raised_ground(0.1f);
+    FootPlacementState state;
+    ClipPose clip;
+    const ClipPose original;
+    int refused = 0;
+    const std::uint64_t before = test::allocation_count();
+    for (int tick = 0; tick < 100; ++tick) {
+        clip.local_rotations = original.local_rotations;  // same size: no allocation
+        clip.local_translations = original.local_translations;
+        clip.model_rotations = original.model_rotations;
+        clip.model_positions = original.model_positions;
+        const FootPlacementJob job{&state, &rig, &step, static_cast<std::uint8_t>(tick / 25 % 2 ? 1 : kBothFeetInContact), 1.0f / 60.0f,
+                                   0.15f, 10.0f, kLegParents, clip.spans()};
+        if (!job.run()) ++refused;
+    }
+    CHECK(test::allocation_count() == before);
+    CHECK(refused == 0);
+}
