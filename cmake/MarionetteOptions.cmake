@@ -23,6 +23,16 @@ if(MARIONETTE_SANITIZE STREQUAL "address")
 elseif(MARIONETTE_SANITIZE STREQUAL "thread")
   target_compile_options(marionette_options INTERFACE -fsanitize=thread -fno-omit-frame-pointer)
   target_link_options(marionette_options INTERFACE -fsanitize=thread)
+elseif(MARIONETTE_SANITIZE STREQUAL "fuzzer")
+  # libFuzzer (clang only): coverage instrumentation plus ASan and UBSan on our
+  # code; only the fuzz executables link libFuzzer's main (-fsanitize=fuzzer,
+  # tests/fuzz/CMakeLists.txt).
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "MARIONETTE_SANITIZE=fuzzer needs clang++ (the fuzz preset uses clang++-14)")
+  endif()
+  target_compile_options(marionette_options INTERFACE
+    -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
+  target_link_options(marionette_options INTERFACE -fsanitize=address,undefined)
 elseif(NOT MARIONETTE_SANITIZE STREQUAL "")
-  message(FATAL_ERROR "MARIONETTE_SANITIZE must be '', 'address' or 'thread'")
+  message(FATAL_ERROR "MARIONETTE_SANITIZE must be '', 'address', 'thread' or 'fuzzer'")
 endif()

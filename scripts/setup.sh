@@ -18,8 +18,10 @@ packages=(
   libopenblas-dev
   # structure check (scripts/check_structure.py): function extents
   universal-ctags
+  # fuzz targets (scripts/fuzz.sh, the `fuzz` preset): clang 14 and its runtime
+  # libraries (libFuzzer, ASan, UBSan), which clang-14 only recommends
+  clang-14 libclang-rt-14-dev
 )
-if [[ "${MARIONETTE_SETUP_CLANG:-0}" == 1 ]]; then packages+=(clang-14); fi
 
 missing=()
 for p in "${packages[@]}"; do

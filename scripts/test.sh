@@ -2,7 +2,8 @@
 # Builds and runs every test: the optimised build first, then the asan build
 # (AddressSanitizer + UBSan). The golden replay traces are checked in both, so an
 # optimisation-dependent result fails here. Then ThreadSanitizer, on the lock-free
-# stress tests only (tests/stress). `.ci/run` calls exactly this.
+# stress tests only (tests/stress). Last, the fuzz targets for 30 s each
+# (scripts/fuzz.sh). `.ci/run` calls exactly this.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -26,3 +27,11 @@ cmake --preset tsan >/dev/null
 cmake --build --preset tsan -j "$jobs" --target marionette_stress_tests
 echo "== tsan: test"
 ctest --preset tsan -R '^stress:' -j 1
+# Fuzz regression gate (issue 18): every libFuzzer target of tests/fuzz for 30 s
+# on its seed corpus and kept reproducers; any crash, UB, leak, timeout or huge
+# allocation fails. Builds only the fuzz targets (the `fuzz` preset, clang 14).
+# FUZZ_TIMEOUT=5: libFuzzer's per-input limit is wall-clock time, and on a
+# loaded 2-core machine inputs that run in 2-40 ms were stalled past 1 s (three
+# false timeouts in two runs, docs/reliability.md); a hang still fails at 5 s.
+echo "== fuzz: every target for 30 s"
+FUZZ_TIMEOUT=5 bash scripts/fuzz.sh 30

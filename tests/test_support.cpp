@@ -2,6 +2,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -28,5 +29,16 @@ std::string read_text_file(const std::string& path) {
 }
 
 std::string source_path(const std::string& relative) { return std::string(MARIONETTE_SOURCE_DIR) + "/" + relative; }
+
+std::vector<std::string> fuzz_regression_files(const std::string& target) {
+    const std::filesystem::path dir = source_path("tests/data/fuzz_regressions/" + target);
+    REQUIRE(std::filesystem::is_directory(dir));
+    std::vector<std::string> files;
+    for (const auto& entry : std::filesystem::directory_iterator(dir))
+        if (entry.is_regular_file()) files.push_back(entry.path().string());
+    std::sort(files.begin(), files.end());
+    REQUIRE(!files.empty());
+    return files;
+}
 
 }  // namespace marionette::test

@@ -1,6 +1,7 @@
 #pragma once
 // Helpers shared by the test programs.
 #include <string>
+#include <vector>
 
 namespace marionette::test {
 
@@ -14,5 +15,9 @@ std::string read_text_file(const std::string& path);
 
 // Path of a file under the source tree.
 std::string source_path(const std::string& relative);
+
+// The reproducers kept for fuzz target `target` (tests/data/fuzz_regressions/
+// <target>/*, sorted); fails the calling test when the folder is missing or empty.
+std::vector<std::string> fuzz_regression_files(const std::string& target);
 
 }  // namespace marionette::test

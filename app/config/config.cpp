@@ -386,8 +386,10 @@ AppConfig apply_config_text(const AppConfig& base, std::string_view text, const 
                 if (table_name == k.table && key.str() == k.key) spec = &k;
             if (!spec)
                 throw ConfigError(file, line_of(node), full, "unknown key (expected one of: " + known + ")");
+            // A named reference: clang 14 cannot capture a structured binding in a lambda.
+            const toml::node& key_node = node;
             visit_field(app, spec->field, [&](auto& value) {
-                value = read_key_value<std::remove_reference_t<decltype(value)>>(node, *spec, file, full);
+                value = read_key_value<std::remove_reference_t<decltype(value)>>(key_node, *spec, file, full);
             });
         }
     }

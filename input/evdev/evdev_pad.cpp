@@ -12,22 +12,11 @@
 namespace marionette::input {
 
 namespace {
-struct KeyMap {
-    std::uint16_t code;
-    Button button;
-};
-// gamepad.rst: BTN_SOUTH/EAST/NORTH/WEST are positions, whatever the labels.
-constexpr KeyMap kKeys[] = {
-    {BTN_SOUTH, Button::south},          {BTN_EAST, Button::east},
-    {BTN_WEST, Button::west},            {BTN_NORTH, Button::north},
-    {BTN_TL, Button::left_shoulder},     {BTN_TR, Button::right_shoulder},
-    {BTN_SELECT, Button::back},          {BTN_START, Button::start},
-    {BTN_MODE, Button::guide},           {BTN_THUMBL, Button::left_stick},
-    {BTN_THUMBR, Button::right_stick},   {BTN_DPAD_UP, Button::dpad_up},
-    {BTN_DPAD_DOWN, Button::dpad_down},  {BTN_DPAD_LEFT, Button::dpad_left},
-    {BTN_DPAD_RIGHT, Button::dpad_right},
-};
-enum AxisIndex { kLx, kLy, kRx, kRy, kLt, kRt, kHatX, kHatY };
+// The pad reads only these keys (EvdevState maps them to buttons).
+constexpr std::uint16_t kReadKeys[] = {BTN_SOUTH, BTN_EAST,   BTN_WEST,     BTN_NORTH,     BTN_TL,
+                                       BTN_TR,    BTN_SELECT, BTN_START,    BTN_MODE,      BTN_THUMBL,
+                                       BTN_THUMBR, BTN_DPAD_UP, BTN_DPAD_DOWN, BTN_DPAD_LEFT, BTN_DPAD_RIGHT,
+                                       BTN_TL2,   BTN_TR2};
 }  // namespace
 
 std::int64_t monotonic_now_ns() {
@@ -69,19 +58,17 @@ Outcome EvdevPad::open(const std::string& path, std::unique_ptr<EvdevPad>& opene
     // where the ioctl is refused (umockdev, old kernels) the read time is used.
     pad->kernel_monotonic_ = libevdev_set_clock_id(dev, CLOCK_MONOTONIC) == 0;
     // Triggers: ABS_Z/ABS_RZ (xpad, hid-playstation), else ABS_HAT2Y/ABS_HAT2X (gamepad.rst).
-    const std::uint16_t codes[kAxes] = {ABS_X, ABS_Y, ABS_RX, ABS_RY, ABS_Z, ABS_RZ, ABS_HAT0X, ABS_HAT0Y};
-    for (int i = 0; i < kAxes; ++i) pad->abs_code_[i] = codes[i];
+    EvdevState& state = pad->state_;
     if (!libevdev_has_event_code(dev, EV_ABS, ABS_Z) && libevdev_has_event_code(dev, EV_ABS, ABS_HAT2Y))
-        pad->abs_code_[kLt] = ABS_HAT2Y;
+        state.set_axis_code(EvdevState::kLt, ABS_HAT2Y);
     if (!libevdev_has_event_code(dev, EV_ABS, ABS_RZ) && libevdev_has_event_code(dev, EV_ABS, ABS_HAT2X))
-        pad->abs_code_[kRt] = ABS_HAT2X;
-    for (int i = 0; i < kAxes; ++i) {
-        const input_absinfo* info = libevdev_get_abs_info(dev, pad->abs_code_[i]);
+        state.set_axis_code(EvdevState::kRt, ABS_HAT2X);
+    for (int i = 0; i < EvdevState::kAxes; ++i) {
+        const input_absinfo* info = libevdev_get_abs_info(dev, state.axis_code(i));
         if (!info || info->maximum <= info->minimum) continue;
-        pad->abs_[i] = {true, info->minimum, info->maximum, info->fuzz, info->flat};
+        state.set_axis_info(i, info->minimum, info->maximum, info->fuzz, info->flat, info->value);
     }
-    pad->analog_left_trigger_ = pad->abs_[kLt].present;
-    pad->analog_right_trigger_ = pad->abs_[kRt].present;
+    for (std::uint16_t code : kReadKeys) state.set_key(code, libevdev_get_event_value(dev, EV_KEY, code) != 0);
     opened = std::move(pad);
     return Outcome::success();
 }
@@ -91,46 +78,12 @@ EvdevPad::~EvdevPad() {
     if (fd_ >= 0) ::close(fd_);
 }
 
-float EvdevPad::axis_value(int i, bool centred) const {
-    const EvdevAbs& a = abs_[i];
-    if (!a.present) return 0.0f;
-    const int v = libevdev_get_event_value(dev_, EV_ABS, abs_code_[i]);
-    if (!centred) return normalise_trigger(v, a.min, a.max);
-    if (apply_flat_ && a.flat > 0) {
-        const std::int64_t centre = static_cast<std::int64_t>(a.min) + (static_cast<std::int64_t>(a.max) - a.min + 1) / 2;
-        if (v - centre <= a.flat && centre - v <= a.flat) return 0.0f;
-    }
-    return normalise_centred(v, a.min, a.max);
-}
-
 void EvdevPad::fill_sample(InputSample& s, std::int64_t kernel_ns) const {
     const std::int64_t now = monotonic_now_ns();
     // A kernel stamp is trusted only when it is plausible (not ahead of now, not
     // older than a second): replayed or foreign clocks fall back to the read time.
     s.t_ns = (kernel_monotonic_ && kernel_ns <= now && now - kernel_ns < 1'000'000'000) ? kernel_ns : now;
-    s.lx = axis_value(kLx, true);
-    s.ly = flip_axis(axis_value(kLy, true));  // evdev y grows downwards
-    s.rx = axis_value(kRx, true);
-    s.ry = flip_axis(axis_value(kRy, true));
-    s.lt = axis_value(kLt, false);
-    s.rt = axis_value(kRt, false);
-    std::uint32_t b = 0;
-    for (const KeyMap& k : kKeys)
-        if (libevdev_get_event_value(dev_, EV_KEY, k.code)) b |= button_bit(k.button);
-    if (abs_[kHatX].present) {
-        const int x = libevdev_get_event_value(dev_, EV_ABS, ABS_HAT0X);
-        if (x < 0) b |= button_bit(Button::dpad_left);
-        if (x > 0) b |= button_bit(Button::dpad_right);
-    }
-    if (abs_[kHatY].present) {
-        const int y = libevdev_get_event_value(dev_, EV_ABS, ABS_HAT0Y);
-        if (y < 0) b |= button_bit(Button::dpad_up);
-        if (y > 0) b |= button_bit(Button::dpad_down);
-    }
-    if (!analog_left_trigger_ && libevdev_get_event_value(dev_, EV_KEY, BTN_TL2)) s.lt = 1.0f;
-    if (!analog_right_trigger_ && libevdev_get_event_value(dev_, EV_KEY, BTN_TR2)) s.rt = 1.0f;
-    s.buttons = b;
-    s.has_device_counter = false;
+    state_.fill(s);
 }
 
 EvdevPad::Status EvdevPad::read_frame(InputSample& out) {
@@ -142,11 +95,13 @@ EvdevPad::Status EvdevPad::read_frame(InputSample& out) {
             // and hands the differences as sync events; drain them, then report
             // the resynchronised state as one frame.
             ++syn_dropped_;
-            do {
+            for (;;) {
                 rc = libevdev_next_event(dev_, LIBEVDEV_READ_FLAG_SYNC, &ev);
-            } while (rc == LIBEVDEV_READ_STATUS_SYNC);
+                if (rc != LIBEVDEV_READ_STATUS_SYNC) break;
+                state_.on_event(ev.type, ev.code, ev.value);
+            }
             if (rc == -ENODEV) return Status::disconnected;
-            events_in_frame_ = 0;
+            state_.start_frame();
             fill_sample(out, monotonic_now_ns());
             ++frames_;
             return Status::frame;
@@ -154,19 +109,15 @@ EvdevPad::Status EvdevPad::read_frame(InputSample& out) {
         if (rc == -EAGAIN) return Status::nothing;
         if (rc == -ENODEV || rc == -EIO || rc == -EBADF) return Status::disconnected;
         if (rc < 0) return Status::nothing;  // -EINTR and friends: try again on the next wake-up
-        if (ev.type == EV_SYN && ev.code == SYN_REPORT) {
-            // The kernel never sends an empty frame; one here is the end of a
-            // packet lost to SYN_DROPPED that libevdev did not drain. Skipping it
-            // makes the result independent of when the drain happened.
-            if (events_in_frame_ == 0) continue;
-            events_in_frame_ = 0;
+        // An empty SYN_REPORT (the end of a packet lost to SYN_DROPPED) completes
+        // no frame (EvdevState::on_event).
+        if (state_.on_event(ev.type, ev.code, ev.value)) {
             const std::int64_t kernel_ns = static_cast<std::int64_t>(ev.input_event_sec) * 1'000'000'000 +
                                            static_cast<std::int64_t>(ev.input_event_usec) * 1000;
             fill_sample(out, kernel_ns);
             ++frames_;
             return Status::frame;
         }
-        if (ev.type != EV_SYN) ++events_in_frame_;
     }
 }
 

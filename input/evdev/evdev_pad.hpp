@@ -9,17 +9,13 @@
 #include <memory>
 #include <string>
 
+#include "input/evdev/evdev_state.hpp"
 #include "input/input_sample.hpp"
 #include "runtime/errors/outcome.hpp"
 
 struct libevdev;
 
 namespace marionette::input {
-
-struct EvdevAbs {
-    bool present = false;
-    std::int32_t min = 0, max = 0, fuzz = 0, flat = 0;
-};
 
 class EvdevPad {
 public:
@@ -37,7 +33,7 @@ public:
     Status read_frame(InputSample& out);
 
     // Apply each axis's `flat` as a rest zone (off for --raw).
-    void set_apply_flat(bool apply) { apply_flat_ = apply; }
+    void set_apply_flat(bool apply) { state_.set_apply_flat(apply); }
 
     int fd() const { return fd_; }
     const std::string& path() const { return path_; }
@@ -47,26 +43,21 @@ public:
     bool kernel_timestamps() const { return kernel_monotonic_; }
     std::uint64_t frames() const { return frames_; }
     std::uint64_t syn_dropped() const { return syn_dropped_; }
-    const EvdevAbs& abs(int index) const { return abs_[index]; }
+    const EvdevAbs& abs(int index) const { return state_.abs(index); }
 
 private:
     EvdevPad() = default;
     void fill_sample(InputSample& out, std::int64_t kernel_ns) const;
-    float axis_value(int index, bool centred) const;
 
     int fd_ = -1;
     libevdev* dev_ = nullptr;
     std::string path_, name_;
     std::uint16_t vendor_ = 0, product_ = 0;
     bool kernel_monotonic_ = false;
-    bool apply_flat_ = true;
-    bool analog_left_trigger_ = false, analog_right_trigger_ = false;
-    // lx ly rx ry lt rt hatx haty
-    static constexpr int kAxes = 8;
-    EvdevAbs abs_[kAxes];
-    std::uint16_t abs_code_[kAxes] = {};
+    // Axis and button values, frame boundaries: every event libevdev delivers
+    // goes through it (input/evdev/evdev_state.hpp).
+    EvdevState state_;
     std::uint64_t frames_ = 0, syn_dropped_ = 0;
-    int events_in_frame_ = 0;
 };
 
 // True when the node's capabilities are a gamepad's.

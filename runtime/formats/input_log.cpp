@@ -21,6 +21,10 @@ constexpr std::uint32_t kMaxConfigBytes = 1u << 20;
 constexpr std::uint32_t kMaxChunkPayload = 64u << 20;
 constexpr std::uint32_t kMaxChunkTicks = 1u << 24;  // ~19 h at 240 Hz; writers flush far sooner
 constexpr int kFieldCount = 7;
+// The largest change between two in-range field values (buttons: 0 .. 2^32-1).
+constexpr std::int64_t kMaxFieldDelta = 0xffffffffll;
+constexpr const char* kFieldNames[kFieldCount] = {"left_x",       "left_y",        "right_x", "right_y",
+                                                   "left_trigger", "right_trigger", "buttons"};
 
 void put_u32(std::vector<std::uint8_t>& out, std::uint32_t v) {
     for (int i = 0; i < 4; ++i) out.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
@@ -296,7 +300,13 @@ ChunkDefect decode_tick_record(std::uint8_t tag, Reader& r, std::int64_t (&field
         if (!(tag & (1u << i))) continue;
         std::uint64_t z = 0;
         if (!r.varint(z)) return "truncated field value";
-        fields[i] += unzigzag(z);
+        // Fields stay in range between records, so a delta beyond 2^32 can
+        // only be corrupt (and would overflow the sum).
+        const std::int64_t delta = unzigzag(z);
+        if (delta < -kMaxFieldDelta || delta > kMaxFieldDelta)
+            return std::string(kFieldNames[i]) + " changes by " + std::to_string(delta) + " at payload byte " +
+                   std::to_string(r.pos) + ", more than any input value can";
+        fields[i] += delta;
     }
     std::uint64_t repeat = 0;
     if (!r.varint(repeat) || repeat == 0) return "bad repeat count";

@@ -66,7 +66,8 @@ Outcome validate_motion_graph(const MotionGraph& g) {
                 return Outcome::failure("clip edge " + std::to_string(i) + " does not run forward inside one clip");
         } else if (e.kind == GraphEdgeKind::transition) {
             if (e.frames != g.window_frames) return Outcome::failure("transition edge " + std::to_string(i) + " is not k frames long");
-            if (a.frame + g.window_frames > g.clips[static_cast<size_t>(a.clip)].frame_count ||
+            // In 64 bits: a file's window may be up to 2^31 - 1 (an int sum would overflow).
+            if (static_cast<std::int64_t>(a.frame) + g.window_frames > g.clips[static_cast<size_t>(a.clip)].frame_count ||
                 b.frame < g.window_frames)
                 return Outcome::failure("transition edge " + std::to_string(i) + " runs past its clips");
         } else {
