@@ -12,6 +12,7 @@
 #include "app/live/clock.hpp"
 #include "app/cli/commands.hpp"
 #include "app/config/config.hpp"
+#include "app/config/config_search.hpp"
 #include "app/io/files.hpp"
 #include "app/graph/graph_files.hpp"
 #include "app/graph/graph_rebuild.hpp"
@@ -96,7 +97,11 @@ std::string missing_pad(const std::string& backend, const std::string& evdev_dir
 }  // namespace
 
 int run_command(const RunOptions& o) {
-    SimConfig config = load_config(o.config_file);
+    // --config, else ~/.config/marionette/, else /etc/marionette/, else the defaults (docs/deploy.md).
+    const ConfigSearchDirs config_dirs = config_search_dirs_from_environment();
+    const ConfigLookup config_found = find_config_file(o.config_file, "marionette.toml", config_dirs);
+    SimConfig config = load_config(config_found.file);
+    fmt::print("marionette: configuration: {}\n", describe_config_lookup(config_found));
     PipelineOptions p;
     std::string source;
     std::string input = o.input;
@@ -175,7 +180,9 @@ int run_command(const RunOptions& o) {
                                                                       : render::PlatformRequest::automatic;
     const render::PlatformKind kind = render::select_platform(request, render::detect_display_environment());
     if (kind != render::PlatformKind::headless) {
-        const RenderConfig rc = load_render_config("");
+        const ConfigLookup render_found = find_config_file(o.render_config_file, "render.toml", config_dirs);
+        const RenderConfig rc = load_render_config(render_found.file);
+        fmt::print("marionette: render settings: {}\n", describe_config_lookup(render_found));
         p.display.gl = true;
         p.display.settings = rc.settings;
         p.display.platform.kind = kind;
