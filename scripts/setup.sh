@@ -18,6 +18,9 @@ packages=(
   libopenblas-dev
   # structure check (scripts/check_structure.py): function extents
   universal-ctags
+  # packaging (scripts/package.sh, tests/packaging): dpkg-shlibdeps, fakeroot, ccache;
+  # systemd-analyze verify and udevadm for the units' and rules' checks
+  dpkg-dev fakeroot ccache systemd udev
 )
 if [[ "${MARIONETTE_SETUP_CLANG:-0}" == 1 ]]; then packages+=(clang-14); fi
 
