@@ -124,6 +124,25 @@ if [[ $(id -u) -eq 0 ]] && command -v setpriv >/dev/null 2>&1; then
   check "doctor as nobody: reports user nobody" python3 -c "import json; d=json.load(open('nobody.json')); assert d['user']=='nobody', d['user']"
 fi
 
+# A pad doctor can see: the Xbox 360 pad of tests/data/umockdev under umockdev
+# (the real sysfs enumeration, the BTN_GAMEPAD capability test, open and the
+# report-rate window on a replayed event stream).
+if command -v umockdev-run >/dev/null 2>&1; then
+  data=$src/tests/data/umockdev
+  "$bin" sim-pad --format evemu --pad xbox --rate 1000 --program "$src/tests/data/programs/umockdev_pad.prog" \
+    --out xbox.events >/dev/null
+  timeout 30 umockdev-run -d "$data/xbox.umockdev" -i "/dev/input/event7=$data/xbox.ioctl" \
+    -e "/dev/input/event7=xbox.events" -- "$bin" doctor --json --rate-window 0.5 >pad.json 2>/dev/null
+  rc=$?
+  check "doctor under umockdev: exit 0" test $rc -eq 0
+  check "doctor under umockdev: the pad is listed, readable, with a measured report rate" python3 -c "
+import json; d=json.load(open('pad.json')); p=d['pads']
+assert len(p)==1, p; p=p[0]
+assert (p['path'],p['backend'],p['vendor_id'],p['product_id'])==('/dev/input/event7','evdev','045e','028e'), p
+assert p['readable'] and p['problem'] is None and p['reports']>0 and p['report_rate_hz']>0, p
+assert not any('no pad' in w for w in d['warnings']), d['warnings']"
+fi
+
 # --- run: which configuration it read ---
 "$bin" run --fast --duration 0.2 >run_default.txt
 check "run says it uses the built-in defaults" grep -qF "marionette: configuration: the built-in defaults (no $XDG_CONFIG_HOME/marionette/marionette.toml, $MARIONETTE_SYSCONFDIR/marionette.toml)" run_default.txt
