@@ -21,6 +21,9 @@ packages=(
   # fuzz targets (scripts/fuzz.sh, the `fuzz` preset): clang 14 and its runtime
   # libraries (libFuzzer, ASan, UBSan), which clang-14 only recommends
   clang-14 libclang-rt-14-dev
+  # packaging (scripts/package.sh, tests/packaging): dpkg-shlibdeps, fakeroot, ccache;
+  # systemd-analyze verify and udevadm for the units' and rules' checks
+  dpkg-dev fakeroot ccache systemd udev
 )
 
 missing=()

@@ -8,9 +8,19 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 jobs=$(nproc)
+# Structure (docs/architecture.md): includes point inward, no function over 120
+# lines, no folder over 30 source files. Seconds; fails before any build.
+echo "== structure"
+python3 scripts/check_structure.py
 for preset in release asan; do
   echo "== $preset: configure and build"
+  if [[ $preset == release ]]; then
+    # ccache for the optimised build, so the package below reuses its objects
+    # (same flags; scripts/package.sh sets the same ccache variables).
+    export CMAKE_CXX_COMPILER_LAUNCHER=ccache CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=1
+  fi
   cmake --preset "$preset" >/dev/null
+  unset CMAKE_CXX_COMPILER_LAUNCHER
   cmake --build --preset "$preset" -j "$jobs"
   echo "== $preset: test"
   ctest --preset "$preset" -j "$jobs"
@@ -18,6 +28,12 @@ for preset in release asan; do
     # Graph bytes under every OpenBLAS kernel and thread count (builds nothing).
     echo "== release: graph builds independent of BLAS"
     bash scripts/check-blas.sh
+    # The Debian package (docs/deploy.md): build it, check its contents and run
+    # it unprivileged from a dpkg -x root. The install into a fresh debootstrap
+    # root is not in CI (about 15 min here, and the network); see the docs.
+    echo "== package: build and test the .deb"
+    deb=$(bash scripts/package.sh | tail -1)
+    bash tests/packaging/package_tests.sh "$deb"
   fi
 done
 # ThreadSanitizer: only the pipeline's stress target (a full tsan build would not
@@ -27,6 +43,10 @@ cmake --preset tsan >/dev/null
 cmake --build --preset tsan -j "$jobs" --target marionette_stress_tests
 echo "== tsan: test"
 ctest --preset tsan -R '^stress:' -j 1
+# Determinism across builds (docs/determinism.md): the golden traces under GCC -O3
+# (a plain Release build) and Clang 14, each compiling the deterministic core only.
+echo "== determinism: goldens under other compilers and optimisation levels"
+bash scripts/check-builds.sh
 # Fuzz regression gate (issue 18): every libFuzzer target of tests/fuzz for 30 s
 # on its seed corpus and kept reproducers; any crash, UB, leak, timeout or huge
 # allocation fails. Builds only the fuzz targets (the `fuzz` preset, clang 14).
@@ -35,3 +55,6 @@ ctest --preset tsan -R '^stress:' -j 1
 # false timeouts in two runs, docs/reliability.md); a hang still fails at 5 s.
 echo "== fuzz: every target for 30 s"
 FUZZ_TIMEOUT=5 bash scripts/fuzz.sh 30
+# Determinism on aarch64 (docs/determinism.md): cross-built core, goldens under qemu.
+echo "== determinism: goldens on aarch64 under qemu"
+bash scripts/check-aarch64.sh

@@ -22,5 +22,6 @@ void register_render_command(CLI::App& app, int& exit_code); // render (offline 
 void register_input_commands(CLI::App& app, int& exit_code);  // input list|monitor|decode, sim-pad
 void register_graph_commands(CLI::App& app, int& exit_code); // graph build, info, path
 void register_gait_eval_command(CLI::App& app, int& exit_code);  // gait-eval
+void register_doctor_command(CLI::App& app, int& exit_code);  // doctor (app/cli/doctor.hpp)
 
 }  // namespace marionette

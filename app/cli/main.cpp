@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
     register_input_commands(app, exit_code);
     register_graph_commands(app, exit_code);
     register_gait_eval_command(app, exit_code);
+    register_doctor_command(app, exit_code);
 
     try {
         app.parse(argc, argv);

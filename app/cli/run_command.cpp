@@ -12,6 +12,7 @@
 #include "app/live/clock.hpp"
 #include "app/cli/commands.hpp"
 #include "app/config/config.hpp"
+#include "app/config/config_search.hpp"
 #include "app/io/files.hpp"
 #include "app/graph/graph_files.hpp"
 #include "app/graph/graph_rebuild.hpp"
@@ -167,10 +168,13 @@ std::string prepare_log_input(const RunOptions& o, const std::string& file, AppC
 // The display: a window or KMS draws with render_es (the run then lasts until
 // the window is closed); headless (also what auto picks with no display) runs
 // the interpolating frame loop without a GPU.
-render::PlatformKind prepare_display(render::PlatformRequest request, PipelineOptions& p) {
+render::PlatformKind prepare_display(const RunOptions& o, const ConfigSearchDirs& config_dirs,
+                                     render::PlatformRequest request, PipelineOptions& p) {
     const render::PlatformKind kind = render::select_platform(request, render::detect_display_environment());
     if (kind == render::PlatformKind::headless) return kind;
-    const RenderConfig rc = load_render_config("");
+    const ConfigLookup render_found = find_config_file(o.render_config_file, "render.toml", config_dirs);
+    const RenderConfig rc = load_render_config(render_found.file);
+    fmt::print("marionette: render settings: {}\n", describe_config_lookup(render_found));
     p.display.gl = true;
     p.display.settings = rc.settings;
     p.display.platform.kind = kind;
@@ -181,6 +185,7 @@ render::PlatformKind prepare_display(render::PlatformRequest request, PipelineOp
     p.display.platform.fullscreen = rc.settings.fullscreen;
     p.display.platform.drm_device = rc.drm_device;
     p.display.platform.kms_mode = rc.kms;
+    // With a display the run lasts until the window is closed (or --duration).
     p.total_ticks = std::numeric_limits<std::uint64_t>::max();
     return kind;
 }
@@ -252,7 +257,11 @@ int report_run(const RunOptions& o, const SimConfig& config, const PipelineResul
 }  // namespace
 
 int run_command(const RunOptions& o) {
-    AppConfig config = load_config(o.config_file);
+    // --config, else ~/.config/marionette/, else /etc/marionette/, else the defaults (docs/deploy.md).
+    const ConfigSearchDirs config_dirs = config_search_dirs_from_environment();
+    const ConfigLookup config_found = find_config_file(o.config_file, "marionette.toml", config_dirs);
+    AppConfig config = load_config(config_found.file);
+    fmt::print("marionette: configuration: {}\n", describe_config_lookup(config_found));
     PipelineOptions p;
     input::InputThreadOptions device;
     const InputChoice input = choose_input(o, device);
@@ -272,7 +281,7 @@ int run_command(const RunOptions& o) {
     }
     const std::uint64_t headless_ticks = p.total_ticks;
     const render::PlatformRequest request = display_request(o.display);
-    const render::PlatformKind kind = prepare_display(request, p);
+    const render::PlatformKind kind = prepare_display(o, config_dirs, request, p);
     if (o.duration_s >= 0.0) p.total_ticks = static_cast<std::uint64_t>(o.duration_s * config.sim.tick_rate_hz + 0.5);
 
     p.config = config.sim;
