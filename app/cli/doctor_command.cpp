@@ -357,8 +357,8 @@ DisplayCheck check_display(const std::string& request, const RenderConfig& rc) {
     std::vector<std::string> errors;
     for (const render::KmsCardProbe& card : render::probe_kms_cards(rc.kms)) {
         if (!rc.drm_device.empty() && card.path != rc.drm_device) continue;
-        if (!card.opened || !card.error.empty() || !card.choice.error.empty()) {
-            const std::string why = !card.error.empty() ? card.error : card.choice.error;
+        if (!card.opened || !card.error.empty() || !card.choice.chosen.ok()) {
+            const std::string why = !card.error.empty() ? card.error : card.choice.chosen.problem();
             const NodeAccess a = node_access(card.path);
             errors.push_back(fmt::format("{}: {} (owned {}:{} mode {:04o})", card.path, why, a.owner, a.group, a.mode));
             continue;

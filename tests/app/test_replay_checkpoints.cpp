@@ -12,7 +12,7 @@ using namespace marionette;
 namespace {
 // Records like `marionette record`: a checkpoint every kCheckpointIntervalTicks and at the end.
 DecodedInputLog record_with_checkpoints(const std::string& program_spec) {
-    const SimConfig config = default_config();
+    const SimConfig config = default_config().sim;
     const std::vector<TickInput> ticks = render_stick_program(load_program(program_spec), config.tick_rate_hz);
     Simulation sim(config);
     InputLogHeader header;

@@ -31,8 +31,10 @@ inline std::uint32_t crc(const std::uint8_t* p, std::size_t n, std::uint32_t see
 }
 }  // namespace detail
 
-// Input log (docs/input-log.md): rewrites the magic, version, header CRC and
-// every chunk's magic, first-tick index and CRC. Chunk tick counts are capped at
+// Input log (docs/input-log.md): rewrites the magic, version (1 stays 1, any
+// other value becomes the current version, so both header layouts are reached),
+// the version 2 header texts' lengths, the header CRC and every chunk's magic,
+// first-tick index and CRC. Chunk tick counts are capped at
 // 4096 (a chunk may legally claim 2^24 ticks of 16 bytes each: memory by
 // design, not a finding) and payload sizes at the bytes left.
 inline void fix_up_input_log(std::vector<std::uint8_t>& b) {
@@ -40,11 +42,23 @@ inline void fix_up_input_log(std::vector<std::uint8_t>& b) {
     constexpr std::size_t kFixed = 28;
     if (b.size() < kFixed + 4) return;
     std::memcpy(b.data(), kInputLogMagic, 8);
-    put_u32(&b[8], kInputLogVersion);
+    const std::uint32_t version = get_u32(&b[8]) == 1 ? 1u : kInputLogVersion;
+    put_u32(&b[8], version);
     std::uint32_t config = get_u32(&b[24]);
     if (config > b.size() - kFixed - 4) config = static_cast<std::uint32_t>(b.size() - kFixed - 4);
     put_u32(&b[24], config);
-    const std::size_t header_end = kFixed + config;
+    std::size_t header_end = kFixed + config;
+    for (int text = 0; version >= 2 && text < 2; ++text) {  // provenance, motion data
+        if (b.size() - header_end < 8) {
+            put_u32(&b[8], 1);  // no room for the version 2 texts: a version 1 header
+            break;
+        }
+        std::uint32_t length = get_u32(&b[header_end]);
+        if (length > b.size() - header_end - 8) length = static_cast<std::uint32_t>(b.size() - header_end - 8);
+        put_u32(&b[header_end], length);
+        header_end += 4 + length;
+    }
+    if (get_u32(&b[8]) == 1) header_end = kFixed + config;
     put_u32(&b[header_end], crc(b.data(), header_end));
     std::size_t pos = header_end + 4;
     std::uint64_t first_tick = 0;
