@@ -55,6 +55,3 @@ bash scripts/check-builds.sh
 # false timeouts in two runs, docs/reliability.md); a hang still fails at 5 s.
 echo "== fuzz: every target for 30 s"
 FUZZ_TIMEOUT=5 bash scripts/fuzz.sh 30
-# Determinism on aarch64 (docs/determinism.md): cross-built core, goldens under qemu.
-echo "== determinism: goldens on aarch64 under qemu"
-bash scripts/check-aarch64.sh
