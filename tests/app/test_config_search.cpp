@@ -68,7 +68,7 @@ TEST_CASE("config search: --config, then the user's, then the system's, then the
     CHECK(find_config_file("", "render.toml", dirs).origin == ConfigOrigin::system);
 }
 
-TEST_CASE("config search: XDG_CONFIG_HOME, else ~/.config; MARIONETTE_SYSCONFDIR overrides the system directory",
+TEST_CASE("config search: XDG_CONFIG_HOME, else ~/.config, MARIONETTE_SYSCONFDIR overrides the system directory",
           "[config]") {
     struct Env {
         std::string name;

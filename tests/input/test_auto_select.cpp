@@ -30,7 +30,7 @@ TEST_CASE("auto: an unsupported or unreadable HID pad falls back to evdev", "[in
     CHECK(choose_input_backend(in).kind == BackendKind::evdev);
 }
 
-TEST_CASE("auto: SDL2 when neither hidraw nor evdev has a pad; none when SDL2 is missing too", "[input][auto]") {
+TEST_CASE("auto: SDL2 when neither hidraw nor evdev has a pad, none when SDL2 is missing too", "[input][auto]") {
     AutoSelectInputs in;
     in.sdl_available = true;
     in.sdl_joysticks = 1;

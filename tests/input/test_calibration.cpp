@@ -54,7 +54,7 @@ TEST_CASE("calibration: anti-deadzone and response curve shape the magnitude", "
     CHECK(x == Approx(0.2 + 0.8 * 0.5));
 }
 
-TEST_CASE("calibration: centre, range and inversion apply in raw mode too; deadzone and curve do not", "[input][calibration]") {
+TEST_CASE("calibration: centre, range and inversion apply in raw mode too, deadzone and curve do not", "[input][calibration]") {
     FamilyCalibration cal;
     cal.left.centre_x = 0.1f;
     cal.left.invert_y = true;
