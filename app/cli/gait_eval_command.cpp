@@ -27,7 +27,7 @@ struct GaitEvalOptions {
     std::string graph_file;
     bool json = false;
     bool check = false;
-    int sweep = 0;            // > 0: run this many generated cases
+    int sweep = -1;           // given: run this many generated cases
     std::uint64_t seed = 1;
     std::string out_dir;      // --sweep: failing cases' .prog and .toml go here
 };
@@ -73,6 +73,7 @@ void print_sweep_text(const SweepSummary& s) {
 }
 
 int gait_sweep_command(const GaitEvalOptions& o) {
+    if (o.sweep < 1 || o.sweep > 1000000) throw ImportError("--sweep", 0, fmt::format("{}: expected a number of cases from 1 to 1000000", o.sweep));
     if (!o.graph_file.empty() || !o.feet_csv.empty() || !o.program.empty() || !o.terrain.empty())
         throw ImportError("--sweep", 0, "generates its own programs and terrains: it takes no --program, --terrain, --graph or --feet-csv");
     const AppConfig app = load_config(o.config_file);
@@ -88,7 +89,7 @@ int gait_sweep_command(const GaitEvalOptions& o) {
 }
 
 int gait_eval_command(const GaitEvalOptions& o) {
-    if (o.sweep > 0) return gait_sweep_command(o);
+    if (o.sweep != -1) return gait_sweep_command(o);
     if (!o.out_dir.empty()) throw ImportError("--out", 0, "only with --sweep (where failing cases are written)");
     if (o.program.empty()) throw ImportError("--program", 0, "required (a stick program file or builtin:NAME), unless --sweep is given");
     const AppConfig app = load_config(o.config_file);
@@ -141,15 +142,14 @@ int gait_eval_command(const GaitEvalOptions& o) {
 void register_gait_eval_command(CLI::App& app, int& exit_code) {
     auto o = std::make_shared<GaitEvalOptions>();
     CLI::App* cmd = app.add_subcommand("gait-eval", "Run the gait headless over a stick program on a terrain and print its metrics");
-    cmd->add_option("--terrain", o->terrain, "terrain file, or a built-in name (flat, stairs, slope, rubble); default: the config's");
+    cmd->add_option("--terrain", o->terrain, "terrain file, or a built-in name (flat, stairs, slope, rubble, building_stairs, hillside, wall); default: the config's");
     cmd->add_option("--program", o->program, "stick program file, or builtin:NAME (required without --sweep)");
     cmd->add_option("--config", o->config_file, "TOML file overriding the defaults")->check(CLI::ExistingFile);
     cmd->add_option("--graph", o->graph_file, "drive the puppet from this motion graph (.mgraph, or default: the embedded one)");
     cmd->add_option("--feet-csv", o->feet_csv, "write a per-tick CSV of both feet (clearance of each sole point) here");
     cmd->add_flag("--json", o->json, "print one JSON object");
     cmd->add_flag("--check", o->check, "exit 1 when a metric breaks its limit (with --graph: when a metric is not finite)");
-    cmd->add_option("--sweep", o->sweep, "run N cases generated over the envelope (docs/gait.md) instead of one program")
-        ->check(CLI::Range(1, 1000000));
+    cmd->add_option("--sweep", o->sweep, "run N cases generated over the envelope (docs/gait.md) instead of one program");
     cmd->add_option("--seed", o->seed, "--sweep: the generator's seed (default 1); the same seed gives the same cases");
     cmd->add_option("--out", o->out_dir, "--sweep: write each failing case's ID.prog and ID.toml into this folder");
     on_parsed(cmd, exit_code, [o] { return gait_eval_command(*o); });

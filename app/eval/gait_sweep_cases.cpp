@@ -242,7 +242,8 @@ std::string make_curbs(SweepRandom& r, SweepGroundParams& g, Terrain& t) {
         if (level + change < 0.0) change = -change;
         level += change;
         g.largest_ledge_m = std::max(g.largest_ledge_m, std::fabs(change));
-        const double length = k + 1 == g.ledges ? env::kGroundHalfSpanM - u
+        // The last level runs on past the reach of any case (no drop at its end).
+        const double length = k + 1 == g.ledges ? 2.0 * env::kGroundHalfSpanM
                                                 : (r.chance(0.4) ? r.uniform(env::kMinStairTreadM, 0.6) : r.uniform(0.6, 4.0));
         add_band(t, a, u, u + length, level);
         heights += fmt::format(" → {:.2f}", level);

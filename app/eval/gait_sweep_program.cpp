@@ -66,13 +66,13 @@ struct ProgramWriter {
     void move(Move m) {
         ++counts[m];
         switch (m) {
-            case kStepTurn: set("hold", duration(150, 2500), direction(), magnitude()); break;
+            case kStepTurn: set("hold", duration(150, 1800), direction(), magnitude()); break;
             case kRampTurn:
                 set("ramp", duration(30, 1200), direction(), magnitude());
-                hold(rng->chance(0.7) ? duration(100, 2000) : 0);
+                hold(rng->chance(0.7) ? duration(100, 1500) : 0);
                 break;
             case kReversal:
-                set("hold", duration(300, 2500), angle + 180.0 + (rng->chance(0.5) ? 0.0 : rng->uniform(-15.0, 15.0)),
+                set("hold", duration(300, 2000), angle + 180.0 + (rng->chance(0.5) ? 0.0 : rng->uniform(-15.0, 15.0)),
                     rng->chance(0.5) && deflection > deadzone ? deflection : magnitude());
                 break;
             case kCircle: circle(); break;
@@ -86,7 +86,7 @@ struct ProgramWriter {
             case kPulses: pulses(); break;
             case kNoise: noise(); break;
             case kNearDeadzone:
-                set(rng->chance(0.5) ? "hold" : "ramp", duration(200, 2000), direction(), near_deadzone());
+                set(rng->chance(0.5) ? "hold" : "ramp", duration(200, 1500), direction(), near_deadzone());
                 break;
             case kPress: {
                 const std::string_view button = kButtonNames[static_cast<std::size_t>(rng->integer(0, kButtonCount - 1))];
@@ -150,7 +150,7 @@ std::string make_program(SweepRandom& r, double first_dir, double deadzone, std:
     // Toward the feature first, so the ground is met.
     w.set(r.chance(0.7) ? "ramp" : "hold", w.duration(30, 800), first_dir, r.chance(0.6) ? 1.0 : w.magnitude());
     // Often long enough (2.5 s and more) for speed_error_pct to measure it.
-    w.hold(r.chance(0.4) ? w.duration(2600, 4000) : w.duration(600, 2500));
+    w.hold(r.chance(0.4) ? w.duration(2600, 4000) : w.duration(300, 2000));
     while (w.elapsed_ms < end_ms) {
         int pick = r.integer(0, 99), m = 0;
         while (pick >= kMoveWeights[m]) pick -= kMoveWeights[m++];
