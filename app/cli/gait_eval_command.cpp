@@ -1,6 +1,8 @@
 // `marionette gait-eval`: runs the gait (or, with --graph, a motion graph) headless
 // over a stick program on a terrain and prints the metrics of docs/gait.md;
 // --check makes a broken limit exit 1 (with --graph: a metric that is not finite).
+// --sweep N --seed S runs N generated cases of the envelope instead (docs/gait.md,
+// "The envelope"; app/eval/gait_sweep.hpp).
 #include <fmt/format.h>
 
 #include <memory>
@@ -8,6 +10,7 @@
 #include "app/cli/cli.hpp"
 #include "app/config/config.hpp"
 #include "app/eval/gait_eval.hpp"
+#include "app/eval/gait_sweep.hpp"
 #include "app/graph/graph_files.hpp"
 #include "app/io/json.hpp"
 #include "app/config/program_source.hpp"
@@ -24,9 +27,71 @@ struct GaitEvalOptions {
     std::string graph_file;
     bool json = false;
     bool check = false;
+    int sweep = -1;           // given: run this many generated cases
+    std::uint64_t seed = 1;
+    std::string out_dir;      // --sweep: failing cases' .prog and .toml go here
 };
 
+std::string sweep_json(const SweepSummary& s) {
+    std::string worst, by_ground, failures;
+    for (int m = 0; m < kSweepMetricCount; ++m)
+        worst += fmt::format("{}{}:{{\"value\":{},\"case\":{},\"limit\":{},\"failing_cases\":{}}}", m ? "," : "",
+                             json::quote(kSweepMetrics[m].name), json::number(s.worst[m].value),
+                             s.worst[m].case_id.empty() ? std::string("null") : json::quote(s.worst[m].case_id),
+                             json::number(kSweepMetrics[m].limit), s.failed_by_metric[m]);
+    for (int g = 0; g < kSweepGroundCount; ++g)
+        by_ground += fmt::format("{}{}:{{\"cases\":{},\"failed\":{}}}", g ? "," : "",
+                                 json::quote(sweep_ground_name(static_cast<SweepGround>(g))), s.cases_by_ground[g],
+                                 s.failed_by_ground[g]);
+    for (const SweepFailure& f : s.failures) {
+        failures += fmt::format("{}{{\"case\":{},\"ground\":{},\"description\":{},\"problem\":{}", failures.empty() ? "" : ",",
+                                json::quote(f.case_id), json::quote(sweep_ground_name(f.ground)), json::quote(f.description),
+                                json::quote(f.problem));
+        for (const SweepMetric& metric : kSweepMetrics)
+            failures += fmt::format(",{}:{}", json::quote(metric.name), json::number(f.metrics.*metric.value));
+        failures += "}";
+    }
+    return fmt::format("{{\"seed\":{},\"cases\":{},\"passed\":{},\"failed\":{},\"ticks\":{},\"worst\":{{{}}},"
+                       "\"by_ground\":{{{}}},\"failures\":[{}]}}\n",
+                       s.seed, s.cases, s.passed, s.cases - s.passed, s.ticks, worst, by_ground, failures);
+}
+
+void print_sweep_text(const SweepSummary& s) {
+    fmt::print("gait-eval --sweep {} --seed {}: {} passed, {} failed ({} ticks simulated)\n", s.cases, s.seed, s.passed,
+               s.cases - s.passed, s.ticks);
+    fmt::print("  {:<24}{:>14}  {:<10}{:>10}  {}\n", "metric", "worst", "limit", "failing", "worst case");
+    for (int m = 0; m < kSweepMetricCount; ++m)
+        fmt::print("  {:<24}{:>14.4f}  < {:<8}{:>10}  {}\n", kSweepMetrics[m].name, s.worst[m].value, kSweepMetrics[m].limit,
+                   s.failed_by_metric[m], s.worst[m].case_id.empty() ? "-" : s.worst[m].case_id);
+    fmt::print("  by ground:");
+    for (int g = 0; g < kSweepGroundCount; ++g)
+        fmt::print(" {} {}/{}", sweep_ground_name(static_cast<SweepGround>(g)), s.cases_by_ground[g] - s.failed_by_ground[g],
+                   s.cases_by_ground[g]);
+    fmt::print(" passed\n");
+    for (const SweepFailure& f : s.failures)
+        fmt::print("  FAILED {}: {}\n      {}\n", f.case_id, f.problem, f.description);
+}
+
+int gait_sweep_command(const GaitEvalOptions& o) {
+    if (o.sweep < 1 || o.sweep > 1000000) throw ImportError("--sweep", 0, fmt::format("{}: expected a number of cases from 1 to 1000000", o.sweep));
+    if (!o.graph_file.empty() || !o.feet_csv.empty() || !o.program.empty() || !o.terrain.empty())
+        throw ImportError("--sweep", 0, "generates its own programs and terrains: it takes no --program, --terrain, --graph or --feet-csv");
+    const AppConfig app = load_config(o.config_file);
+    const SweepSummary s = run_gait_sweep(app.sim, o.seed, o.sweep, o.out_dir);
+    if (o.json) fmt::print("{}", sweep_json(s));
+    else print_sweep_text(s);
+    if (o.check && s.passed != s.cases) {
+        fmt::print(stderr, "gait-eval --sweep {} --seed {}: {} of {} cases broke a limit\n", o.sweep, o.seed, s.cases - s.passed,
+                   s.cases);
+        return 1;
+    }
+    return 0;
+}
+
 int gait_eval_command(const GaitEvalOptions& o) {
+    if (o.sweep != -1) return gait_sweep_command(o);
+    if (!o.out_dir.empty()) throw ImportError("--out", 0, "only with --sweep (where failing cases are written)");
+    if (o.program.empty()) throw ImportError("--program", 0, "required (a stick program file or builtin:NAME), unless --sweep is given");
     const AppConfig app = load_config(o.config_file);
     SimConfig config = app.sim;
     if (!o.terrain.empty()) {
@@ -77,13 +142,16 @@ int gait_eval_command(const GaitEvalOptions& o) {
 void register_gait_eval_command(CLI::App& app, int& exit_code) {
     auto o = std::make_shared<GaitEvalOptions>();
     CLI::App* cmd = app.add_subcommand("gait-eval", "Run the gait headless over a stick program on a terrain and print its metrics");
-    cmd->add_option("--terrain", o->terrain, "terrain file, or a built-in name (flat, stairs, slope, rubble); default: the config's");
-    cmd->add_option("--program", o->program, "stick program file, or builtin:NAME")->required();
+    cmd->add_option("--terrain", o->terrain, "terrain file, or a built-in name (flat, stairs, slope, rubble, building_stairs, hillside, wall); default: the config's");
+    cmd->add_option("--program", o->program, "stick program file, or builtin:NAME (required without --sweep)");
     cmd->add_option("--config", o->config_file, "TOML file overriding the defaults")->check(CLI::ExistingFile);
     cmd->add_option("--graph", o->graph_file, "drive the puppet from this motion graph (.mgraph, or default: the embedded one)");
     cmd->add_option("--feet-csv", o->feet_csv, "write a per-tick CSV of both feet (clearance of each sole point) here");
     cmd->add_flag("--json", o->json, "print one JSON object");
     cmd->add_flag("--check", o->check, "exit 1 when a metric breaks its limit (with --graph: when a metric is not finite)");
+    cmd->add_option("--sweep", o->sweep, "run N cases generated over the envelope (docs/gait.md) instead of one program");
+    cmd->add_option("--seed", o->seed, "--sweep: the generator's seed (default 1); the same seed gives the same cases");
+    cmd->add_option("--out", o->out_dir, "--sweep: write each failing case's ID.prog and ID.toml into this folder");
     on_parsed(cmd, exit_code, [o] { return gait_eval_command(*o); });
 }
 

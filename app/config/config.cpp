@@ -213,14 +213,14 @@ void apply_terrain_table(SimConfig& config, const toml::table& table, const std:
     const Terrain inline_data = terrain_from_table(table, file, "terrain.");  // also rejects unknown keys
     if (const toml::node* n = table.get("name")) {
         const auto* s = n->as_string();
-        if (!s) throw ConfigError(file, line_of(*n), "terrain.name", "expected a string: flat, stairs, slope, rubble or a file path");
+        if (!s) throw ConfigError(file, line_of(*n), "terrain.name", "expected a string: " + builtin_terrain_list() + " or a file path");
         name = s->get();
         if (!table_has_terrain_data(table)) {
             bool builtin = false;
             for (const char* b : kBuiltinTerrains) builtin = builtin || name == b || name == "builtin:" + std::string(b);
             if (!builtin && !std::ifstream(name))
                 throw ConfigError(file, line_of(*n), "terrain.name",
-                                  "no terrain '" + name + "' (expected flat, stairs, slope, rubble or a readable file path)");
+                                  "no terrain '" + name + "' (expected " + builtin_terrain_list() + " or a readable file path)");
             config.terrain = load_terrain(name);
         }
     }

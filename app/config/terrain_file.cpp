@@ -170,6 +170,12 @@ Terrain parse_terrain_text(std::string_view text, const std::string& file) {
     return terrain_from_table(doc, file, "");
 }
 
+std::string builtin_terrain_list() {
+    std::string list;
+    for (const char* name : kBuiltinTerrains) list += (list.empty() ? "" : ", ") + std::string(name);
+    return list;
+}
+
 Terrain load_terrain(const std::string& spec) {
     std::string name = spec;
     if (name.rfind("builtin:", 0) == 0) name = name.substr(8);
@@ -179,9 +185,9 @@ Terrain load_terrain(const std::string& spec) {
             return parse_terrain_text(embedded::find(path), path);
         }
     if (spec.rfind("builtin:", 0) == 0)
-        throw ConfigError(spec, 0, "", "no built-in terrain named '" + name + "' (expected flat, stairs, slope or rubble)");
+        throw ConfigError(spec, 0, "", "no built-in terrain named '" + name + "' (expected one of " + builtin_terrain_list() + ")");
     std::ifstream in(spec, std::ios::binary);
-    if (!in) throw ConfigError(spec, 0, "", "cannot open the terrain file (expected a path or one of flat, stairs, slope, rubble)");
+    if (!in) throw ConfigError(spec, 0, "", "cannot open the terrain file (expected a path or one of " + builtin_terrain_list() + ")");
     std::ostringstream ss;
     ss << in.rdbuf();
     return parse_terrain_text(ss.str(), spec);

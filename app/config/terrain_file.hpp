@@ -17,7 +17,11 @@
 namespace marionette {
 
 // The terrains compiled into the binary: config/terrain/NAME.toml.
-inline constexpr const char* kBuiltinTerrains[] = {"flat", "stairs", "slope", "rubble"};
+inline constexpr const char* kBuiltinTerrains[] = {"flat",     "stairs",          "slope",    "rubble",
+                                                   "building_stairs", "hillside", "wall"};
+
+// "flat, stairs, …, wall": the built-in names, for messages.
+std::string builtin_terrain_list();
 
 // Parses terrain TOML text. `file_name` is used in error messages.
 Terrain parse_terrain_text(std::string_view toml_text, const std::string& file_name);
