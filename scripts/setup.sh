@@ -24,6 +24,8 @@ packages=(
   # packaging (scripts/package.sh, tests/packaging): dpkg-shlibdeps, fakeroot, ccache;
   # systemd-analyze verify and udevadm for the units' and rules' checks
   dpkg-dev fakeroot ccache systemd udev
+  # sd_notify for the service's READY=1 / WATCHDOG=1 (app/live/service_notify.cpp)
+  libsystemd-dev
 )
 
 missing=()

@@ -27,6 +27,7 @@
 
 #include "app/cli/cli.hpp"
 #include "app/cli/doctor.hpp"
+#include "app/live/recording.hpp"
 #include "app/config/config.hpp"
 #include "app/config/config_search.hpp"
 #include "app/config/render_config.hpp"
@@ -392,18 +393,12 @@ LimitCheck check_limit(int resource, int capability, std::uint64_t needed) {
     return l;
 }
 
-std::string env_or(const char* name, const std::string& fallback) {
-    const char* v = std::getenv(name);
-    return v != nullptr && *v == '/' ? std::string(v) : fallback;
-}
-
-// The service's StateDirectory (systemd sets STATE_DIRECTORY), else
-// $XDG_STATE_HOME/marionette, else ~/.local/state/marionette.
+// Where `run --record auto` writes (app/live/recording.hpp): the service's
+// StateDirectory (systemd sets STATE_DIRECTORY), else $XDG_STATE_HOME/marionette,
+// else ~/.local/state/marionette.
 StorageCheck check_storage() {
     StorageCheck s;
-    const char* state = std::getenv("STATE_DIRECTORY");
-    if (state != nullptr && *state == '/') s.dir = std::string(state) + "/recordings";
-    else s.dir = env_or("XDG_STATE_HOME", env_or("HOME", "/tmp") + "/.local/state") + "/marionette/recordings";
+    s.dir = default_recordings_dir();
     std::error_code ec;
     std::filesystem::path p = s.dir;
     s.exists = std::filesystem::is_directory(p, ec);

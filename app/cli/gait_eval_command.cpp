@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "app/cli/cli.hpp"
+#include "app/io/log.hpp"
 #include "app/config/config.hpp"
 #include "app/eval/gait_eval.hpp"
 #include "app/eval/gait_sweep.hpp"
@@ -132,7 +133,7 @@ int gait_eval_command(const GaitEvalOptions& o) {
         if (!checked.ok()) fmt::print("  {}: {}\n", with_graph ? "NOT FINITE" : "LIMITS BROKEN", checked.problem());
     }
     if (o.check && !checked.ok()) {
-        fmt::print(stderr, "gait-eval: {} on {}: {}\n", o.program, config.terrain_name, checked.problem());
+        log_message(LogLevel::info, fmt::format("gait-eval: {} on {}: {}", o.program, config.terrain_name, checked.problem()));
         return 1;
     }
     return 0;

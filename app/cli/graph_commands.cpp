@@ -11,6 +11,7 @@
 #include <set>
 
 #include "app/cli/cli.hpp"
+#include "app/io/log.hpp"
 #include "app/config/config.hpp"
 #include "app/graph/default_graph.hpp"
 #include "app/config/embedded.hpp"
@@ -364,7 +365,7 @@ int graph_path_command(const GraphPathOptions& o) {
     const bool found = search.run(start_node);
     const double micros = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
     if (!found) {
-        fmt::print(stderr, "error: no path from {} to {} in the pruned graph\n", o.from, o.to);
+        log_message(LogLevel::error, fmt::format("error: no path from {} to {} in the pruned graph", o.from, o.to));
         return 1;
     }
     const double cost = search.cost() + lead_frames / g.frame_rate;

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "app/cli/cli.hpp"
+#include "app/io/log.hpp"
 #include "app/config/embedded.hpp"
 #include "app/io/files.hpp"
 #include "app/io/json.hpp"
@@ -80,8 +81,8 @@ int decode_command(const DecodeOptions& o) {
     while (at < bytes.size()) {
         const std::size_t length = report_length(*format, bytes[at]);
         if (at + length > bytes.size()) {
-            fmt::print(stderr, "error: {}: at byte {}: {} bytes left, expected a whole {}-byte {} report\n", o.file, at,
-                       bytes.size() - at, length, o.format);
+            log_message(LogLevel::error, fmt::format("error: {}: at byte {}: {} bytes left, expected a whole {}-byte {} report", o.file, at,
+                       bytes.size() - at, length, o.format));
             counters.count(ParseStatus::too_short);
             break;
         }
@@ -95,13 +96,13 @@ int decode_command(const DecodeOptions& o) {
             s.t_ns = static_cast<std::int64_t>(index) * 1'000'000'000 / o.rate_hz;
             fmt::print("{}\n", sample_line(s, o.json));
         } else if (st != ParseStatus::ignored) {
-            fmt::print(stderr, "warning: {}: at byte {}: report {} rejected: {}\n", o.file, at, index, parse_status_name(st));
+            log_message(LogLevel::warning, fmt::format("warning: {}: at byte {}: report {} rejected: {}", o.file, at, index, parse_status_name(st)));
         }
         at += length;
         ++index;
     }
-    fmt::print(stderr, "{}: {} reports decoded, {} rejected, {} ignored\n", o.file, counters.accepted, counters.rejected(),
-               counters.ignored);
+    log_message(LogLevel::info, fmt::format("{}: {} reports decoded, {} rejected, {} ignored", o.file, counters.accepted, counters.rejected(),
+               counters.ignored));
     if (counters.too_short > 0 || counters.accepted == 0) return 2;
     return 0;
 }
@@ -125,7 +126,7 @@ int monitor_command(const MonitorOptions& o) {
     if (!o.device.empty() && backend == "auto") backend = o.device.find("hidraw") != std::string::npos ? "hidraw" : "evdev";
     if (backend == "auto") {
         const BackendChoice choice = probe_input_backend(o.evdev_dir);
-        fmt::print(stderr, "input: {}\n", choice.reason);
+        log_message(LogLevel::info, fmt::format("input: {}", choice.reason));
         if (choice.kind == BackendKind::none) return 1;
         backend = std::string(backend_name(choice.kind));
     }
@@ -152,13 +153,13 @@ int monitor_command(const MonitorOptions& o) {
         EvdevBackend evdev;
         const Outcome opened = o.device.empty() ? evdev.watch_directory(o.evdev_dir) : evdev.open_device(o.device);
         if (!opened.ok()) {
-            fmt::print(stderr, "error: {}\n", opened.problem());
+            log_message(LogLevel::error, fmt::format("error: {}", opened.problem()));
             return 1;
         }
         evdev.set_raw(o.raw);
         for (int i = 0; i < EvdevBackend::kMaxPads; ++i)
             if (const EvdevPad* p = evdev.pad(i))
-                fmt::print(stderr, "input: evdev: {} \"{}\" {:04x}:{:04x}\n", p->path(), p->name(), p->vendor_id(), p->product_id());
+                log_message(LogLevel::info, fmt::format("input: evdev: {} \"{}\" {:04x}:{:04x}", p->path(), p->name(), p->vendor_id(), p->product_id()));
         std::array<InputSample, 64> batch{};
         std::uint64_t disconnects = 0;
         while (!done() && !timed_out()) {
@@ -166,10 +167,10 @@ int monitor_command(const MonitorOptions& o) {
             for (int i = 0; i < n && !done(); ++i) emit(batch[static_cast<std::size_t>(i)], config.family(DeviceFamily::evdev));
             if (evdev.disconnects() != disconnects) {
                 disconnects = evdev.disconnects();
-                fmt::print(stderr, "input: device unplugged ({} connected)\n", evdev.connected());
+                log_message(LogLevel::info, fmt::format("input: device unplugged ({} connected)", evdev.connected()));
             }
         }
-        if (evdev.syn_dropped() > 0) fmt::print(stderr, "input: {} SYN_DROPPED resynchronised\n", evdev.syn_dropped());
+        if (evdev.syn_dropped() > 0) log_message(LogLevel::info, fmt::format("input: {} SYN_DROPPED resynchronised", evdev.syn_dropped()));
     } else if (*kind == BackendKind::hidraw) {
         std::string path = o.device;
         std::optional<HidFormat> format;
@@ -180,22 +181,22 @@ int monitor_command(const MonitorOptions& o) {
                 break;
             }
         if (!format) {
-            fmt::print(stderr, "error: {}\n", path.empty() ? "no supported HID pad found" : path + ": not a supported HID pad");
+            log_message(LogLevel::error, fmt::format("error: {}", path.empty() ? "no supported HID pad found" : path + ": not a supported HID pad"));
             return 1;
         }
         auto transport = open_hidapi_transport(path);
         if (!transport) {
-            fmt::print(stderr, "error: {}: cannot open the hidraw node (permissions? see docs/input.md)\n", path);
+            log_message(LogLevel::error, fmt::format("error: {}: cannot open the hidraw node (permissions? see docs/input.md)", path));
             return 1;
         }
         HidPad pad(*transport, *format);
         pad.initialise(200);
-        fmt::print(stderr, "input: hidraw: {} ({})\n", path, hid_format_name(*format));
+        log_message(LogLevel::info, fmt::format("input: hidraw: {} ({})", path, hid_format_name(*format)));
         InputSample s;
         while (!done() && !timed_out()) {
             const HidPad::Result r = pad.read(s, 20);
             if (r == HidPad::Result::disconnected) {
-                fmt::print(stderr, "input: device unplugged\n");
+                log_message(LogLevel::info, "input: device unplugged");
                 break;
             }
             if (r == HidPad::Result::sample) {
@@ -203,21 +204,21 @@ int monitor_command(const MonitorOptions& o) {
                 emit(s, config.family(family_of(*format)));
             }
         }
-        if (pad.counters().rejected() > 0) fmt::print(stderr, "input: {} reports rejected\n", pad.counters().rejected());
+        if (pad.counters().rejected() > 0) log_message(LogLevel::info, fmt::format("input: {} reports rejected", pad.counters().rejected()));
     } else {
         SdlBackend sdl;
         if (const Outcome started = sdl.start(config.sdl_mapping_file); !started.ok()) {
-            fmt::print(stderr, "error: {}\n", started.problem());
+            log_message(LogLevel::error, fmt::format("error: {}", started.problem()));
             return 1;
         }
-        fmt::print(stderr, "input: sdl: {} joystick(s), {} mapping(s) loaded{}\n", sdl.joysticks(), sdl.mappings_loaded(),
-                   sdl.connected() ? ", using \"" + sdl.controller_name() + "\"" : "");
+        log_message(LogLevel::info, fmt::format("input: sdl: {} joystick(s), {} mapping(s) loaded{}", sdl.joysticks(), sdl.mappings_loaded(),
+                   sdl.connected() ? ", using \"" + sdl.controller_name() + "\"" : ""));
         std::array<InputSample, 1> batch{};
         while (!done() && !timed_out())
             if (sdl.poll(batch, 20) == 1) emit(batch[0], config.family(DeviceFamily::sdl));
     }
     if (o.count > 0 && printed < o.count) {
-        fmt::print(stderr, "input: {} of {} samples before the timeout\n", printed, o.count);
+        log_message(LogLevel::info, fmt::format("input: {} of {} samples before the timeout", printed, o.count));
         return 1;
     }
     return 0;

@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include "app/cli/cli.hpp"
+#include "app/io/log.hpp"
 #include "app/cli/commands.hpp"
 #include "app/config/config.hpp"
 #include "app/io/files.hpp"
@@ -55,8 +56,8 @@ int record_command(const RecordOptions& o) {
 }
 
 int replay_command(const ReplayCommandOptions& o) {
-    const DecodedInputLog log = decode_input_log(read_binary_file(o.log_file), o.log_file);
-    if (!log.warning.empty()) fmt::print(stderr, "warning: {}\n", log.warning);
+    const DecodedInputLog log = decode_input_log(read_input_log_bytes(o.log_file), o.log_file);
+    if (!log.warning.empty()) log_message(LogLevel::warning, fmt::format("warning: {}", log.warning));
     ReplayOptions options;
     options.trace_csv = o.trace_csv;
     options.joints_csv = o.joints_csv;

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "app/cli/cli.hpp"
+#include "app/io/log.hpp"
 #include "app/eval/log_provenance.hpp"
 #include "runtime/errors/parse_error.hpp"
 
@@ -20,18 +21,20 @@ int main(int argc, char** argv) {
     register_gait_eval_command(app, exit_code);
     register_doctor_command(app, exit_code);
 
+    // "<N>" priority prefixes when stderr is the journal (docs/deploy.md "Logs").
+    init_log_prefixes_from_environment();
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
     } catch (const ReplayDesync& e) {
-        fmt::print(stderr, "error: {}\n", e.what());
+        log_message(LogLevel::error, fmt::format("error: {}", e.what()));
         return 3;  // the replay is not exact (docs/determinism.md)
     } catch (const ParseError& e) {  // a bad file, configuration or option value
-        fmt::print(stderr, "error: {}\n", e.what());
+        log_message(LogLevel::error, fmt::format("error: {}", e.what()));
         return 2;
     } catch (const std::exception& e) {
-        fmt::print(stderr, "error: {}\n", e.what());
+        log_message(LogLevel::error, fmt::format("error: {}", e.what()));
         return 1;
     }
     return exit_code;

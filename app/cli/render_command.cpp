@@ -13,6 +13,7 @@
 #include <sys/wait.h>
 
 #include "app/cli/cli.hpp"
+#include "app/io/log.hpp"
 #include "app/config/config.hpp"
 #include "app/io/files.hpp"
 #include "app/config/render_config.hpp"
@@ -121,8 +122,8 @@ int render_command(const RenderCommandOptions& o) {
                                      "PNG frames (--out DIR) need nothing");
         ffmpeg = *found;
     }
-    const DecodedInputLog log = decode_input_log(read_binary_file(o.log_file), o.log_file);
-    if (!log.warning.empty()) fmt::print(stderr, "warning: {}\n", log.warning);
+    const DecodedInputLog log = decode_input_log(read_input_log_bytes(o.log_file), o.log_file);
+    if (!log.warning.empty()) log_message(LogLevel::warning, fmt::format("warning: {}", log.warning));
     if (!o.out_dir.empty()) {
         std::error_code ec;
         std::filesystem::create_directories(o.out_dir, ec);

@@ -5,10 +5,12 @@
 
 #include <atomic>
 #include <csignal>
+#include <cstdlib>
 #include <limits>
 #include <memory>
 
 #include "app/cli/cli.hpp"
+#include "app/io/log.hpp"
 #include "app/live/clock.hpp"
 #include "app/cli/commands.hpp"
 #include "app/config/config.hpp"
@@ -18,6 +20,7 @@
 #include "app/graph/graph_rebuild.hpp"
 #include "app/io/json.hpp"
 #include "app/live/pipeline.hpp"
+#include "app/live/recording.hpp"
 #include "app/config/program_source.hpp"
 #include "app/config/embedded.hpp"
 #include "app/config/render_config.hpp"
@@ -142,8 +145,8 @@ std::string prepare_program_input(const RunOptions& o, const std::string& progra
 // matches it (--config may retune on top, nothing structural), and its recorded
 // changes scheduled before their ticks. Returns the description for the banner.
 std::string prepare_log_input(const RunOptions& o, const std::string& file, AppConfig& config, PipelineOptions& p) {
-    const DecodedInputLog log = decode_input_log(read_binary_file(file), file);
-    if (!log.warning.empty()) fmt::print(stderr, "warning: {}\n", log.warning);
+    const DecodedInputLog log = decode_input_log(read_input_log_bytes(file), file);
+    if (!log.warning.empty()) log_message(LogLevel::warning, fmt::format("warning: {}", log.warning));
     config = config_from_text(log.header.config_text, file + " (embedded configuration)");
     if (!o.config_file.empty()) {
         const AppConfig tuned = apply_config_text(config, read_text_file(o.config_file), o.config_file);
@@ -222,7 +225,7 @@ PipelineResult run_stoppable(const RunOptions& o, PipelineOptions& p, render::Pl
         r = run_pipeline(p);
     } catch (const render::PlatformError& e) {
         if (request != render::PlatformRequest::automatic) throw;
-        fmt::print(stderr, "warning: {}; running headless\n", e.what());
+        log_message(LogLevel::warning, fmt::format("warning: {}; running headless", e.what()));
         p.display.gl = false;
         if (o.duration_s < 0.0) p.total_ticks = headless_ticks;
         r = run_pipeline(p);
@@ -244,14 +247,46 @@ int report_run(const RunOptions& o, const SimConfig& config, const PipelineResul
                r.distance_m, r.top_speed, r.catch_up_drops, r.input_latency.quantile_ns(0.5) / 1e6,
                r.input_latency.quantile_ns(0.99) / 1e6, r.input_latency.max_ns / 1e6, r.samples_dropped, r.frames,
                r.missed_frames, r.final_hash);
+    if (!r.record_files.empty())
+        fmt::print("recording: {}{}{}\n", r.record_files.front(),
+                   r.record_files.size() > 1 ? fmt::format(" and {} continuation files", r.record_files.size() - 1) : "",
+                   r.recording_stopped.empty() ? "" : " (ended early: " + r.recording_stopped + ")");
+    if (r.watchdog_pings + r.watchdog_withheld > 0)
+        fmt::print("watchdog: {} pings sent, {} withheld (a loop made no progress)\n", r.watchdog_pings, r.watchdog_withheld);
     if (r.stopped) fmt::print("shutdown: threads joined and files closed {:.1f} ms after the signal\n", r.shutdown_ms);
     if (r.records_dropped > 0) {
-        fmt::print(stderr, "error: the writer fell behind and {} tick records were lost: {}{}are incomplete\n",
+        log_message(LogLevel::error, fmt::format("error: the writer fell behind and {} tick records were lost: {}{}are incomplete",
                    r.records_dropped, o.record_file.empty() ? "" : o.record_file + " ",
-                   o.trace_file.empty() ? "" : o.trace_file + " ");
+                   o.trace_file.empty() ? "" : o.trace_file + " "));
         return 1;
     }
     return 0;
+}
+
+// --record FILE, or --record auto: a new file in the recordings directory
+// (docs/deploy.md), whose oldest recordings make room under [recording]'s limits.
+void prepare_recording(const RunOptions& o, const AppConfig& config, PipelineOptions& p) {
+    if (o.record_file.empty()) return;
+    p.record_limits = recording_limits(config.recording);
+    if (o.record_file == "auto") {
+        p.record_rotate_dir = default_recordings_dir();
+        p.record_file = new_recording_path(p.record_rotate_dir);
+    } else {
+        p.record_file = o.record_file;
+        p.record_limits.max_total_bytes = 0;  // not our directory: nothing is deleted there
+    }
+    fmt::print("marionette: recording to {}\n", p.record_file);
+}
+
+// MARIONETTE_TEST_STALL_SIM_MS (the watchdog test's hook): milliseconds, 0–600000.
+std::int64_t test_stall_from_environment() {
+    const char* v = std::getenv("MARIONETTE_TEST_STALL_SIM_MS");
+    if (v == nullptr || *v == '\0') return 0;
+    char* end = nullptr;
+    const long long ms = std::strtoll(v, &end, 10);
+    if (*end != '\0' || ms < 0 || ms > 600000)
+        throw ImportError("MARIONETTE_TEST_STALL_SIM_MS", 0, std::string("'") + v + "' is not a number of milliseconds in [0, 600000]");
+    return ms;
 }
 
 }  // namespace
@@ -289,7 +324,8 @@ int run_command(const RunOptions& o) {
     p.graph = load_graph_argument_rebuilding_stale(o.graph_file, config.sim, config.graph_build);
     p.graph_argument = o.graph_file;
     p.virtual_time = o.fast;
-    p.record_file = o.record_file;
+    prepare_recording(o, config, p);
+    p.test_stall_simulation_ms = test_stall_from_environment();
     p.trace_file = o.trace_file;
     p.watch_config_file = o.config_file;  // live tuning of the file given
     p.stop_request = &g_stop_requested;
@@ -308,7 +344,8 @@ void register_run_command(CLI::App& app, int& exit_code) {
     cmd->add_option("--input", o->input, "auto|evdev|hidapi|sdl|sim:PROGRAM|log:FILE (PROGRAM: a file or builtin:NAME)");
     cmd->add_option("--display", o->display, "auto|kms|window|headless")
         ->check(CLI::IsMember({"auto", "headless", "kms", "window"}));
-    cmd->add_option("--record", o->record_file, "write the input log here");
+    cmd->add_option("--record", o->record_file,
+                    "write the input log to FILE, or auto: a new file in the recordings directory ([recording])");
     cmd->add_option("--trace", o->trace_file, "per-tick CSV: tick,hash,root_x,root_y,root_z (as replay --trace)");
     cmd->add_option("--graph", o->graph_file, "drive the puppet from this motion graph (.mgraph, or default: the embedded one)");
     cmd->add_option("--stats-json", o->stats_json, "write the run's statistics here as JSON");

@@ -26,6 +26,16 @@ struct RealtimeConfig {
     bool operator==(const RealtimeConfig&) const = default;
 };
 
+// [recording]: where `run --record auto` keeps its logs and how much room they
+// may take (docs/config.md, app/live/recording.hpp). Read at start only, not in logs.
+struct RecordingConfig {
+    float max_total_mb = 1024.0f;  // all recordings in the directory; the oldest are deleted first
+    float max_file_mb = 64.0f;     // a recording continues in NAME.1, NAME.2, ... past this
+    float min_free_mb = 64.0f;     // recording stops rather than leave less free on the file system
+
+    bool operator==(const RecordingConfig&) const = default;
+};
+
 // [motion_graph] build parameters (docs/motion-graph.md), read by graph builds
 // only: `graph build`, the default graph and the stale-graph rebuild.
 struct GraphBuildConfig {
@@ -45,6 +55,7 @@ struct AppConfig {
     SimConfig sim;                 // what the tick reads; logs embed exactly this
     RealtimeConfig realtime;
     GraphBuildConfig graph_build;
+    RecordingConfig recording;
 };
 
 }  // namespace marionette

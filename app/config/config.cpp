@@ -20,7 +20,7 @@ namespace {
 // A key's field: a member of one of AppConfig's parts. Only SimConfig's are
 // written into logs (serialize_config); the others are read from files only.
 using Field = std::variant<std::int32_t SimConfig::*, float SimConfig::*, std::int32_t RealtimeConfig::*,
-                           std::int32_t GraphBuildConfig::*, float GraphBuildConfig::*>;
+                           std::int32_t GraphBuildConfig::*, float GraphBuildConfig::*, float RecordingConfig::*>;
 
 template <typename Member>
 struct MemberOf;
@@ -33,6 +33,7 @@ struct MemberOf<Value Part::*> {
 SimConfig& part_of(AppConfig& c, const SimConfig*) { return c.sim; }
 RealtimeConfig& part_of(AppConfig& c, const RealtimeConfig*) { return c.realtime; }
 GraphBuildConfig& part_of(AppConfig& c, const GraphBuildConfig*) { return c.graph_build; }
+RecordingConfig& part_of(AppConfig& c, const RecordingConfig*) { return c.recording; }
 
 // Calls visit(value) with a reference to the field's value in `config`.
 template <typename Visit>
@@ -92,6 +93,10 @@ const KeySpec kKeys[] = {
     {"realtime", "simulation_cpu", &RealtimeConfig::simulation_cpu, -1, 1023, "CPU the simulation thread is pinned to (-1: any)"},
     {"realtime", "render_cpu", &RealtimeConfig::render_cpu, -1, 1023, "CPU the render thread is pinned to (-1: any)"},
     {"realtime", "lock_memory", &RealtimeConfig::lock_memory, 0, 1, "1: lock all memory (mlockall) before the threads start"},
+    // [recording]: `marionette run --record auto` (docs/deploy.md), read at start only (RecordingConfig: not in logs).
+    {"recording", "max_total_mb", &RecordingConfig::max_total_mb, 0.01, 1048576.0, "all recordings in the directory together; the oldest are deleted first (MB)"},
+    {"recording", "max_file_mb", &RecordingConfig::max_file_mb, 0.01, 1048576.0, "one file of a recording; it continues in NAME.1, NAME.2, ... (MB)"},
+    {"recording", "min_free_mb", &RecordingConfig::min_free_mb, 0.0, 1048576.0, "free space recording always leaves on the file system (MB)"},
     // [motion_graph] (docs/motion-graph.md): the build parameters (GraphBuildConfig: not in logs), then the
     // controller's keys, which the tick reads.
     {"motion_graph", "analysis_rate_hz", &GraphBuildConfig::graph_analysis_rate_hz, 5, 240, "rate clips are resampled to for the graph build"},

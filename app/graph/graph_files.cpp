@@ -1,4 +1,5 @@
 #include "app/graph/graph_files.hpp"
+#include "app/io/log.hpp"
 
 #include <cerrno>
 #include <cstring>
@@ -73,8 +74,8 @@ std::array<std::int32_t, kGraphActionButtons> resolve_graph_buttons(const SimCon
         unmapped += fmt::format("{}{} = \"{}\"", unmapped.empty() ? "" : ", ", kButtonNames[b], binding.label);
     }
     if (!unmapped.empty())
-        fmt::print(stderr, "warning: {} has no label for the default [motion_graph.buttons] {} (its labels: {}); those buttons do nothing\n",
-                   graph_name, unmapped, labels);
+        log_message(LogLevel::warning, fmt::format("warning: {} has no label for the default [motion_graph.buttons] {} (its labels: {}); those buttons do nothing",
+                   graph_name, unmapped, labels));
     return out;
 }
 

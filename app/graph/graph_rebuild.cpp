@@ -1,4 +1,5 @@
 #include "app/graph/graph_rebuild.hpp"
+#include "app/io/log.hpp"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -67,9 +68,10 @@ std::shared_ptr<const MotionGraph> load_graph_argument_rebuilding_stale(const st
     for (const std::string& c : sources.clips) check(c);
     check(sources.labels);
     if (!missing.empty()) {
-        fmt::print(stderr, "warning: {}: {} of its source files {} missing (first: {}); using the graph as it is, "
-                           "unchecked for staleness\n",
-                   argument, missing.size(), missing.size() == 1 ? "is" : "are", missing.front());
+        log_message(LogLevel::warning,
+                    fmt::format("warning: {}: {} of its source files {} missing (first: {}); using the graph as it is, "
+                                "unchecked for staleness",
+                                argument, missing.size(), missing.size() == 1 ? "is" : "are", missing.front()));
         return graph;
     }
     offline::GraphBuildParams params = graph_build_params(build);
@@ -81,10 +83,12 @@ std::shared_ptr<const MotionGraph> load_graph_argument_rebuilding_stale(const st
     // The file keeps build_seconds 0 (same sources, same bytes); the time is only printed.
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     write_binary_file_atomically(argument, serialize_motion_graph(out.graph));
-    fmt::print(stderr, "{}: stale (source hash {:016x}, its {} source files and the [motion_graph] build parameters now hash "
-                       "{:016x}): rebuilt in {:.2f} s and written back\n",
-               argument, stored_hash, sources.clips.size() + (sources.asf.empty() ? 0 : 1) + (sources.labels.empty() ? 0 : 1),
-               current_hash, seconds);
+    log_message(LogLevel::notice,
+                fmt::format("{}: stale (source hash {:016x}, its {} source files and the [motion_graph] build parameters now "
+                            "hash {:016x}): rebuilt in {:.2f} s and written back",
+                            argument, stored_hash,
+                            sources.clips.size() + (sources.asf.empty() ? 0 : 1) + (sources.labels.empty() ? 0 : 1),
+                            current_hash, seconds));
     return std::make_shared<const MotionGraph>(std::move(out.graph));
 }
 

@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -20,6 +21,27 @@ std::string read_text_file(const std::string& path) {
     std::ostringstream ss;
     ss << in.rdbuf();
     return ss.str();
+}
+
+std::vector<std::string> input_log_files(const std::string& path) {
+    std::vector<std::string> out{path};
+    for (size_t n = 1;; ++n) {
+        const std::string next = path + "." + std::to_string(n);
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(next, ec)) break;
+        out.push_back(next);
+    }
+    return out;
+}
+
+std::vector<std::uint8_t> read_input_log_bytes(const std::string& path) {
+    std::vector<std::uint8_t> bytes = read_binary_file(path);
+    const std::vector<std::string> files = input_log_files(path);
+    for (size_t i = 1; i < files.size(); ++i) {
+        const std::vector<std::uint8_t> more = read_binary_file(files[i]);
+        bytes.insert(bytes.end(), more.begin(), more.end());
+    }
+    return bytes;
 }
 
 void write_text_file(const std::string& path, const std::string& text) {

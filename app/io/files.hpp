@@ -16,6 +16,12 @@ std::string read_text_file(const std::string& path);
 // Writes atomically enough for outputs (truncate + write); throws std::runtime_error.
 void write_text_file(const std::string& path, const std::string& text);
 
+// An input log may span files (app/live/recording.hpp): PATH, then PATH.1,
+// PATH.2, ... (continuations holding whole chunks). These list and read them
+// in order, as one log; a lone file is just itself.
+std::vector<std::string> input_log_files(const std::string& path);
+std::vector<std::uint8_t> read_input_log_bytes(const std::string& path);
+
 class InputLogFile {
 public:
     // Creates the file and writes the header; throws std::runtime_error on failure.

@@ -1,4 +1,5 @@
 #include "app/live/pipeline.hpp"
+#include "app/io/log.hpp"
 
 #include <fmt/format.h>
 #include <poll.h>
@@ -16,6 +17,7 @@
 #include "app/eval/log_provenance.hpp"
 #include "app/graph/graph_files.hpp"
 #include "app/live/realtime.hpp"
+#include "app/live/service_notify.hpp"
 #include "app/eval/replay.hpp"
 #include "input/input_thread.hpp"
 #include "render_es/interpolate.hpp"
@@ -217,7 +219,7 @@ struct SimulationThreadResult {
 // the tick runs (virtual time, and recordings replayed live, which stay exact
 // even when the input thread is descheduled for a moment).
 void simulation_thread(PipelineShared& sh, SimulationLoop& loop, std::uint64_t total_ticks, std::int64_t t0,
-                       bool virtual_time, bool wait_for_input, SimulationThreadResult& result) {
+                       bool virtual_time, bool wait_for_input, std::int64_t stall_ms, SimulationThreadResult& result) {
     set_simulation_float_mode();
     const SimConfig& config = loop.simulation().config();
     FixedStepDriver driver = FixedStepDriver::at_rate(config.tick_rate_hz, config.max_catch_up_ticks);
@@ -234,10 +236,13 @@ void simulation_thread(PipelineShared& sh, SimulationLoop& loop, std::uint64_t t
         const std::int64_t took = monotonic_ns() - start;
         result.tick_time.add(took);
         if (took > window_tick_max) window_tick_max = took;
+        sh.counters.simulation_heartbeat.fetch_add(1, std::memory_order_relaxed);
         if (++ticks % ticks_per_second == 0) {
             sh.counters.tick_time_max_ns.store(window_tick_max, std::memory_order_relaxed);
             window_tick_max = 0;
         }
+        // The watchdog test's stuck simulation (a test hook, off unless asked).
+        if (stall_ms > 0 && ticks == ticks_per_second) sleep_until_ns_or_stop(monotonic_ns() + stall_ms * 1'000'000, sh.stop);
     };
     while (ticks < total_ticks && !sh.stop.load(std::memory_order_relaxed)) {
         if (virtual_time) {
@@ -447,15 +452,15 @@ struct LiveTuning {
         try {
             next = load_config(watcher->path());
         } catch (const ConfigError& e) {
-            fmt::print(err, "config: {}; keeping the previous configuration\n", e.what());
+            log_message(LogLevel::warning, fmt::format("config: {}; keeping the previous configuration", e.what()), err);
             return;
         }
         Outcome kept = structure_unchanged(published, next.sim);
         if (kept.ok() && !(next.realtime == realtime)) kept = Outcome::failure("realtime (thread settings)");
         if (kept.ok() && simulation) kept = simulation->motion_source_allowed(next.sim);
         if (!kept.ok()) {
-            fmt::print(err, "config: {}: {} cannot change while running (restart to apply it); keeping the previous configuration\n",
-                       watcher->path(), kept.problem());
+            log_message(LogLevel::warning, fmt::format("config: {}: {} cannot change while running (restart to apply it); keeping the previous configuration",
+                       watcher->path(), kept.problem()), err);
             return;
         }
         // The graph build keys are not the tick's: an edit of only those changes nothing here.
@@ -486,7 +491,8 @@ public:
             header.config_text = serialize_config(o.config);
             header.provenance = build_provenance();
             header.motion_data = motion_data_reference(o.graph_argument, o.graph.get());
-            log_ = std::make_unique<InputLogFile>(o.record_file, header);
+            log_ = std::make_unique<RecordingSink>(RecordingOptions{o.record_file, o.record_rotate_dir, o.record_limits},
+                                                   header, o.err);
         }
         if (!o.trace_file.empty()) {
             trace_.reset(std::fopen(o.trace_file.c_str(), "wb"));
@@ -527,6 +533,8 @@ public:
         if (log_) {
             if (ticks_since_checkpoint_ > 0) log_->append_checkpoint(last_hash_);  // the state after the last tick
             log_->close();
+            result_.recording_stopped = log_->stop_reason();
+            result_.record_files = log_->files();
         }
         if (trace_ && std::fclose(trace_.release()) != 0) throw std::runtime_error(o_.trace_file + ": write failed");
     }
@@ -586,7 +594,7 @@ private:
     PipelineResult& result_;
     const int tick_rate_hz_;
     const std::uint32_t flush_ticks_;
-    std::unique_ptr<InputLogFile> log_;
+    std::unique_ptr<RecordingSink> log_;  // ends itself cleanly on a full disk
     std::uint64_t last_hash_ = 0;               // the state after the newest tick logged
     std::uint64_t ticks_since_checkpoint_ = 0;  // ticks logged after the newest checkpoint
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> trace_{nullptr, &std::fclose};
@@ -634,6 +642,7 @@ public:
         }
         pthread_sigmask(SIG_SETMASK, &previous_mask, nullptr);
         apply_realtime_settings();
+        notifier_.ready();  // systemd (Type=notify): the pipeline runs
     }
 
     // The writer: this thread drains the records into the log, the trace and the
@@ -656,11 +665,14 @@ public:
                 result_.display_closed = true;  // closing the window ends the run normally
                 sh_.stop.store(true);
             }
+            notifier_.poll(now, sh_.counters.simulation_heartbeat.load(std::memory_order_relaxed),
+                           sh_.counters.frames.load(std::memory_order_relaxed));
             tuning_.wait_and_poll(sh_, o_.err);
         }
     }
 
     PipelineResult shut_down() {
+        notifier_.stopping();
         sh_.stop.store(true);
         if (o_.device) {
             publish_device_counters();
@@ -707,7 +719,8 @@ private:
             in_thread_ = std::thread(input_thread, std::ref(sh_), std::cref(o_.script), t0, o_.virtual_time);
         }
         sim_thread_ = std::thread(simulation_thread, std::ref(sh_), std::ref(*loop_), o_.total_ticks, t0,
-                                  o_.virtual_time, !o_.script.stamp_when_read, std::ref(sim_result_));
+                                  o_.virtual_time, !o_.script.stamp_when_read, o_.test_stall_simulation_ms,
+                                  std::ref(sim_result_));
     }
 
     void start_display() {
@@ -738,8 +751,8 @@ private:
         note_realtime_failure(apply_thread_settings(gfx_thread_, "mario-render", fifo ? rt.render_priority : 0,
                                                     rt.render_cpu));
         if (!result_.realtime_warning.empty())
-            fmt::print(o_.err, "warning: real-time settings not permitted ({}); running with normal scheduling\n",
-                       result_.realtime_warning);
+            log_message(LogLevel::warning, fmt::format("warning: real-time settings not permitted ({}); running with normal scheduling",
+                       result_.realtime_warning), o_.err);
     }
 
     void note_realtime_failure(const Outcome& applied) {
@@ -776,6 +789,8 @@ private:
         r.config_changes = loop_->config_changes();
         r.disconnects = loop_->assembler().disconnects();
         r.reconnects = loop_->assembler().reconnects();
+        r.watchdog_pings = notifier_.pings_sent();
+        r.watchdog_withheld = notifier_.pings_withheld();
     }
 
     const PipelineOptions& o_;
@@ -792,6 +807,7 @@ private:
     ThreadGuard guard_{{&sim_thread_, &in_thread_, &gfx_thread_}, sh_};
     std::int64_t wall_start_ = 0;
     std::int64_t stop_seen_ = -1;  // when the writer saw the stop request
+    ServiceNotifier notifier_;     // systemd's READY=1 and WATCHDOG=1
 };
 
 }  // namespace

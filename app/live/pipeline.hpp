@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "app/config/app_config.hpp"
+#include "app/live/recording.hpp"
 #include "render_es/platform.hpp"
 #include "render_es/settings.hpp"
 #include "runtime/formats/input_log.hpp"
@@ -87,6 +88,9 @@ struct PipelineCounters {
     std::atomic<std::uint64_t> missed_frames{0};
     std::atomic<std::uint64_t> catch_up_drops{0};
     std::atomic<std::uint64_t> records_dropped{0};
+    // Bumped by the simulation thread at every tick: with `frames` (the render
+    // loop's), what the systemd watchdog looks at (app/live/service_notify.hpp).
+    std::atomic<std::uint64_t> simulation_heartbeat{0};
     // Maxima over the last second, published once a second by their thread.
     std::atomic<std::int64_t> tick_time_max_ns{0};
     std::atomic<std::int64_t> input_latency_max_ns{0};
@@ -219,12 +223,17 @@ struct PipelineOptions {
     bool virtual_time = false;
     int frame_rate_hz = 60;            // the headless frame loop's pace
     DisplayOptions display;
-    std::string record_file;           // input log ("" = none)
+    std::string record_file;           // input log ("" = none): its first file (app/live/recording.hpp)
+    std::string record_rotate_dir;     // --record auto: keep the [recording] limits by deleting the oldest here
+    RecordingLimits record_limits;
     std::string trace_file;            // per-tick CSV ("" = none)
     std::string watch_config_file;     // live tuning ("" = none)
     bool status_lines = true;          // once per simulated second
     std::FILE* out = stdout;           // status lines and notices
     std::FILE* err = stderr;           // configuration errors and warnings
+    // Test hook (MARIONETTE_TEST_STALL_SIM_MS, docs/deploy.md): the simulation
+    // thread sleeps this long after its first simulated second, as if stuck.
+    std::int64_t test_stall_simulation_ms = 0;
     // Set (by a signal handler) to ask for a clean stop; the time it was set, if known.
     const std::atomic<bool>* stop_request = nullptr;
     const std::atomic<std::int64_t>* stop_request_time_ns = nullptr;
@@ -255,6 +264,10 @@ struct PipelineResult {
     bool display_closed = false;        // the window was closed (ends the run)
     std::string display_description;    // the GL platform, when one was used
     std::string input_description;      // the device backend, when one was used
+    std::string recording_stopped;      // why the recording ended early ("" = it did not)
+    std::vector<std::string> record_files;  // the recording's files, first to last
+    std::uint64_t watchdog_pings = 0;       // WATCHDOG=1 sent to systemd
+    std::uint64_t watchdog_withheld = 0;    // intervals in which a loop made no progress
 };
 
 // Runs the whole pipeline until total_ticks have run, a stop is requested or the

@@ -28,7 +28,7 @@ done
 check "nothing under /usr/local or /usr/etc" test "$(grep -c '^/usr/local/\|^/usr/etc' contents.txt)" -eq 0
 depends=$(dpkg-deb -f "$deb" Depends)
 echo "Depends: $depends"
-for lib in libc6 libstdc++6 libegl1 libgles2 libseat1 libhidapi-hidraw0 libevdev2 passwd; do
+for lib in libc6 libstdc++6 libegl1 libgles2 libseat1 libhidapi-hidraw0 libevdev2 libsystemd0 passwd; do
   check "Depends names $lib (from the linked libraries)" grep -q "\b$lib\b" <<<"$depends"
 done
 mkdir control && dpkg-deb -e "$deb" control
