@@ -462,9 +462,10 @@ std::string config_diff(const SimConfig& from, const SimConfig& to) {
 // workers block SIGINT/SIGTERM, so it reaches this thread, and poll() is never
 // restarted), an edit wakes it through inotify, and the record ring holds 68 s;
 // so it waits 50 ms at a time, 20 wake-ups a second (docs/pipeline.md, "Power").
-// In virtual time the simulation may be waiting for room in the ring: 5 ms.
+// In virtual time the simulation may be waiting for room in the ring, and once
+// stopping the threads are about to end: 5 ms then.
 constexpr int kWriterPollMs = 50;
-constexpr int kWriterPollVirtualMs = 5;
+constexpr int kWriterPollShortMs = 5;
 // Editors write in steps: a watched file is read once it has been quiet this long.
 constexpr std::int64_t kEditQuietNs = 100'000'000;
 // A log chunk is written at least this often while ticks are pending (real time).
@@ -721,7 +722,8 @@ public:
                 result_.display_closed = true;  // closing the window ends the run normally
                 sh_.stop.store(true);
             }
-            tuning_.wait_and_poll(sh_, o_.err, o_.virtual_time ? kWriterPollVirtualMs : kWriterPollMs);
+            const bool hurry = o_.virtual_time || sh_.stop.load(std::memory_order_relaxed);
+            tuning_.wait_and_poll(sh_, o_.err, hurry ? kWriterPollShortMs : kWriterPollMs);
         }
     }
 
