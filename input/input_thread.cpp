@@ -19,7 +19,9 @@ constexpr int kBatch = 64;                // evdev samples taken per poll
 constexpr int kEvdevPollTimeoutMs = 20;   // an idle evdev runner wakes this often to see stop()
 constexpr int kSdlPollTimeoutMs = 5;      // … and an idle SDL runner this often
 constexpr int kHidInitTimeoutMs = 200;    // a pad's start-up dialogue waits this long for its replies
-constexpr int kHidReadTimeoutMs = 1;      // a hidraw read waits at most this long: at least 1 kHz
+// A hidraw read returns as soon as a report comes; with none it waits this long
+// (then looks at stop()): 1 ms woke an idle thread 1000 times a second for nothing.
+constexpr int kHidReadTimeoutMs = 10;
 constexpr int kHidReopenPollMs = 10;      // while a hidraw pad is unplugged, stop() is seen this soon
 
 }  // namespace

@@ -2,8 +2,9 @@
 
 namespace marionette::render {
 
-void interpolate_state(const PuppetState& previous, const PuppetState& current, float alpha, PuppetState& out) {
-    const float t = alpha < 0.0f ? 0.0f : (alpha > 1.0f ? 1.0f : alpha);
+namespace {
+// previous + t·(current − previous) for any t (t > 1 extrapolates).
+void blend_state(const PuppetState& previous, const PuppetState& current, float t, PuppetState& out) {
     out = current;
     out.root_position = lerp(previous.root_position, current.root_position, t);
     out.velocity = previous.velocity + (current.velocity - previous.velocity) * t;
@@ -20,6 +21,15 @@ void interpolate_state(const PuppetState& previous, const PuppetState& current, 
         out.local_translations[i] = lerp(previous.local_translations[i], current.local_translations[i], t);
         out.local_rotations[i] = quat_slerp(previous.local_rotations[i], current.local_rotations[i], t);
     }
+}
+}  // namespace
+
+void interpolate_state(const PuppetState& previous, const PuppetState& current, float alpha, PuppetState& out) {
+    blend_state(previous, current, alpha < 0.0f ? 0.0f : (alpha > 1.0f ? 1.0f : alpha), out);
+}
+
+void extrapolate_state(const PuppetState& previous, const PuppetState& current, float ahead, PuppetState& out) {
+    blend_state(previous, current, 1.0f + (ahead < 0.0f ? 0.0f : (ahead > 1.0f ? 1.0f : ahead)), out);
 }
 
 }  // namespace marionette::render

@@ -12,4 +12,9 @@ namespace marionette::render {
 // may alias neither input.
 void interpolate_state(const PuppetState& previous, const PuppetState& current, float alpha, PuppetState& out);
 
+// out = current carried on along the last tick's motion by `ahead` ticks, clamped
+// to [0, 1]: the same blend with alpha = 1 + ahead (positions extrapolate
+// linearly, rotations along the same great arc). [timing] interpolation = "extrapolate".
+void extrapolate_state(const PuppetState& previous, const PuppetState& current, float ahead, PuppetState& out);
+
 }  // namespace marionette::render

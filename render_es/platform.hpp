@@ -122,6 +122,9 @@ public:
     // Resolves MSAA and shows the frame: a buffer swap (vsync-paced in a window),
     // a page flip on the next vblank (KMS), nothing for headless.
     virtual PresentResult present() = 0;
+    // When the last present() reached the screen, CLOCK_MONOTONIC ns, where the
+    // platform is told (KMS: the page-flip event's vblank time); 0 when unknown.
+    virtual std::int64_t last_present_ns() const { return 0; }
     // Leaves the context current on no thread, so another thread's begin_frame()
     // can take it (a display opened on the main thread, drawn by the render thread).
     virtual void release_current() = 0;

@@ -256,6 +256,8 @@ public:
         return PresentResult::ok;
     }
 
+    std::int64_t last_present_ns() const override { return flip_time_ns_; }
+
     void release_current() override { eglMakeCurrent(egl_display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT); }
 
     PlatformEvents poll_events() override {
@@ -411,8 +413,13 @@ private:
     void wait_for_flip() {
         drmEventContext events{};
         events.version = 2;
-        events.page_flip_handler = [](int, unsigned, unsigned, unsigned, void* self) {
-            static_cast<KmsPlatform*>(self)->flip_pending_ = false;
+        events.page_flip_handler = [](int, unsigned, unsigned tv_sec, unsigned tv_usec, void* self) {
+            auto* platform = static_cast<KmsPlatform*>(self);
+            platform->flip_pending_ = false;
+            // The vblank the flip landed on; DRM stamps it with CLOCK_MONOTONIC
+            // (DRM_CAP_TIMESTAMP_MONOTONIC, on every kernel since 3.8).
+            platform->flip_time_ns_ = static_cast<std::int64_t>(tv_sec) * 1'000'000'000 +
+                                      static_cast<std::int64_t>(tv_usec) * 1'000;
         };
         pollfd p{seat_.fd, POLLIN, 0};
         while (flip_pending_) {
@@ -432,6 +439,7 @@ private:
     bool atomic_ = false;
     bool mode_set_ = false;
     bool flip_pending_ = false;
+    std::int64_t flip_time_ns_ = 0;  // the last page flip's vblank (0: none yet)
     std::uint32_t mode_blob_ = 0;
     gbm_device* gbm_ = nullptr;
     gbm_surface* gbm_surface_ = nullptr;

@@ -25,6 +25,7 @@ FrameResult View::frame(const PuppetState& state, const DebugOverlay& overlay, s
     platform_->begin_frame();
     renderer_->draw(state, overlay, hud_text, platform_->width(), platform_->height(), dt_s);
     result.present = platform_->present();
+    result.present_ns = result.present == PresentResult::ok ? platform_->last_present_ns() : 0;
     if (result.present != PresentResult::ok) {
         // Rebuild the context and everything in it; the next frame draws normally.
         if (!platform_->recover())

@@ -17,6 +17,9 @@ namespace marionette::render {
 
 struct FrameResult {
     PresentResult present = PresentResult::ok;
+    // When the frame reached the screen (CLOCK_MONOTONIC ns) if the platform knows:
+    // the page flip's vblank on KMS; 0 otherwise (a window: the caller stamps after the swap).
+    std::int64_t present_ns = 0;
     bool recovered = false;      // the context or surface was rebuilt this frame
     PlatformEvents events;
 };

@@ -52,19 +52,34 @@ template <typename Histogram>
 std::string histogram_json(const Histogram& h) {
     return histogram_json(h.quantile_ns(0.5), h.quantile_ns(0.99), h.max_ns, h.mean_ns());
 }
+// The same in milliseconds.
+std::string histogram_json_ms(const PresentLatencyHistogram& h) {
+    return fmt::format("{{\"p50\":{},\"p99\":{},\"max\":{},\"mean\":{}}}", json::number(h.quantile_ns(0.5) / 1e6),
+                       json::number(h.quantile_ns(0.99) / 1e6), json::number(h.max_ns / 1e6),
+                       json::number(h.mean_ns() / 1e6));
+}
+// End to end, per frame that showed new input (docs/pipeline.md, "Latency").
+std::string present_latency_json(const PipelineResult& r) {
+    return fmt::format("\"interpolation\":{},\"input_to_present_ms\":{{\"frames\":{},\"oldest\":{},\"newest\":{}}},"
+                       "\"tick_to_present_ms\":{}",
+                       json::quote(interpolation_name(r.interpolation)), r.present_latency.oldest.count,
+                       histogram_json_ms(r.present_latency.oldest), histogram_json_ms(r.present_latency.newest),
+                       histogram_json_ms(r.present_latency.tick_to_present));
+}
 
 void write_stats_json(const std::string& path, const RunOptions& o, const SimConfig& config, const PipelineResult& r) {
     const std::string text = fmt::format(
         "{{\"input\":{},\"display\":{},\"tick_rate_hz\":{},\"ticks\":{},\"duration_s\":{},\"wall_s\":{},"
         "\"stopped\":{},\"shutdown_ms\":{},\"final_hash\":\"{:016x}\","
-        "\"tick_time_us\":{},\"frame_time_us\":{},\"input_to_tick_latency_us\":{},"
+        "\"tick_time_us\":{},\"frame_time_us\":{},\"input_to_tick_latency_us\":{},{},"
         "\"samples\":{},\"dropped_samples\":{},\"frames\":{},\"missed_frames\":{},\"catch_up_drops\":{},"
         "\"records_dropped\":{},\"config_changes\":{},\"disconnects\":{},\"reconnects\":{},"
         "\"distance_m\":{},\"top_speed_m_s\":{},\"realtime_warning\":{}}}\n",
         json::quote(o.input), json::quote(r.display_description.empty() ? "headless" : r.display_description),
         config.tick_rate_hz, r.ticks, json::number(static_cast<double>(r.ticks) / config.tick_rate_hz),
         json::number(r.wall_s), r.stopped ? "true" : "false", json::number(r.shutdown_ms), r.final_hash,
-        histogram_json(r.tick_time), histogram_json(r.frame_time), histogram_json(r.input_latency), r.samples_pushed,
+        histogram_json(r.tick_time), histogram_json(r.frame_time), histogram_json(r.input_latency),
+        present_latency_json(r), r.samples_pushed,
         r.samples_dropped, r.frames, r.missed_frames, r.catch_up_drops, r.records_dropped, r.config_changes,
         r.disconnects, r.reconnects, json::number(r.distance_m), json::number(r.top_speed),
         r.realtime_warning.empty() ? "null" : json::quote(r.realtime_warning));
@@ -241,11 +256,15 @@ PipelineResult run_stoppable(const RunOptions& o, PipelineOptions& p, render::Pl
 int report_run(const RunOptions& o, const SimConfig& config, const PipelineResult& r) {
     if (!o.stats_json.empty()) write_stats_json(o.stats_json, o, config, r);
     fmt::print("{}: {:.1f} s, {} ticks; walked {:.1f} m, top speed {:.2f} m/s; {} catch-up drops; "
-               "input→tick latency p50 {:.2f} ms p99 {:.2f} ms max {:.2f} ms; {} samples dropped; {} frames ({} missed); "
+               "input→tick latency p50 {:.2f} ms p99 {:.2f} ms max {:.2f} ms; input→present ({}) p50 {:.2f} ms "
+               "p99 {:.2f} ms max {:.2f} ms; {} samples dropped; {} frames ({} missed); "
                "final state hash {:016x}\n",
                r.stopped ? "stopped" : (r.display_closed ? "window closed" : "demo finished"), static_cast<double>(r.ticks) / config.tick_rate_hz, r.ticks,
                r.distance_m, r.top_speed, r.catch_up_drops, r.input_latency.quantile_ns(0.5) / 1e6,
-               r.input_latency.quantile_ns(0.99) / 1e6, r.input_latency.max_ns / 1e6, r.samples_dropped, r.frames,
+               r.input_latency.quantile_ns(0.99) / 1e6, r.input_latency.max_ns / 1e6,
+               interpolation_name(r.interpolation), r.present_latency.oldest.quantile_ns(0.5) / 1e6,
+               r.present_latency.oldest.quantile_ns(0.99) / 1e6, r.present_latency.oldest.max_ns / 1e6,
+               r.samples_dropped, r.frames,
                r.missed_frames, r.final_hash);
     if (!r.record_files.empty())
         fmt::print("recording: {}{}{}\n", r.record_files.front(),
@@ -321,6 +340,7 @@ int run_command(const RunOptions& o) {
 
     p.config = config.sim;
     p.realtime = config.realtime;
+    p.interpolation = config.timing.interpolation;
     p.graph = load_graph_argument_rebuilding_stale(o.graph_file, config.sim, config.graph_build);
     p.graph_argument = o.graph_file;
     p.virtual_time = o.fast;

@@ -1,9 +1,9 @@
 #pragma once
 // What `marionette` reads from a configuration file: the simulation's part
 // (SimConfig, runtime/sim/sim_config.hpp: every key the tick reads, and all an
-// input log embeds) plus two parts the tick never reads: the live pipeline's
-// thread settings ([realtime]) and the offline graph build's parameters (the
-// [motion_graph] build keys). Loading, validation and the documentation of each
+// input log embeds) plus parts the tick never reads: the live pipeline's
+// thread settings ([realtime]) and render timing ([timing]), and the offline
+// graph build's parameters (the [motion_graph] build keys). Loading, validation and the documentation of each
 // key live with the TOML schema (app/config/config.cpp, docs/config.md); the
 // defaults here are the ones config/marionette.toml states.
 #include <cstdint>
@@ -51,11 +51,27 @@ struct GraphBuildConfig {
     bool operator==(const GraphBuildConfig&) const = default;
 };
 
+// [timing]: what the render thread draws (app/live/pipeline.hpp, FrameLoop),
+// applied at start only. Never read by the simulation, never in logs: the three
+// choices give the same ticks, hashes and recordings.
+enum class Interpolation : std::uint8_t {
+    interpolate,  // one tick behind, between the two newest ticks (no extrapolation)
+    extrapolate,  // the newest tick, carried forward by the time since it was due (at most one tick)
+    latest,       // the newest tick as it is, without delay
+};
+
+struct TimingConfig {
+    Interpolation interpolation = Interpolation::interpolate;
+
+    bool operator==(const TimingConfig&) const = default;
+};
+
 struct AppConfig {
     SimConfig sim;                 // what the tick reads; logs embed exactly this
     RealtimeConfig realtime;
     GraphBuildConfig graph_build;
     RecordingConfig recording;
+    TimingConfig timing;
 };
 
 }  // namespace marionette

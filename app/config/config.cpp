@@ -138,10 +138,15 @@ const KeySpec kKeys[] = {
     {"gait", "breath_period_s", &SimConfig::breath_period_s, 0.5, 20.0, "length of one breath (s)"},
 };
 
-// [motion] source, the one string-valued key; the names index MotionSourceSetting.
+// [motion] source, a string-valued key; the names index MotionSourceSetting.
 constexpr const char* kMotionSourceNames[] = {"auto", "gait", "graph", "graph_feet"};
+// [timing] interpolation, the other one (not the tick's: never serialized); the names index Interpolation.
+constexpr const char* kInterpolationNames[] = {"interpolate", "extrapolate", "latest"};
+constexpr const char* kInterpolationDoc =
+    "what the render thread draws: interpolate (one tick behind), extrapolate or latest (the newest tick)";
 
 void apply_motion_source(SimConfig& config, const toml::node& node, const std::string& file);
+void apply_interpolation(TimingConfig& timing, const toml::node& node, const std::string& file);
 
 int line_of(const toml::node& node) { return static_cast<int>(node.source().begin.line); }
 
@@ -150,6 +155,7 @@ std::string known_keys_of(std::string_view table) {
     for (const KeySpec& k : kKeys)
         if (table == k.table) out += (out.empty() ? "" : ", ") + std::string(k.key);
     if (table == "motion_graph") out += ", buttons (the [motion_graph.buttons] table)";
+    if (table == "timing") out = "interpolation";
     return out;
 }
 
@@ -161,7 +167,7 @@ std::string known_tables() {
             out += (out.empty() ? "" : ", ") + std::string(k.table);
             last = k.table;
         }
-    return out + ", terrain";
+    return out + ", terrain, timing";
 }
 
 template <typename Number>
@@ -345,6 +351,7 @@ std::vector<ConfigKeyInfo> config_schema() {
     for (const KeySpec& k : kKeys)
         out.push_back({k.table, k.key, is_integer(k.field) ? "integer" : "float", k.min, k.max, k.doc});
     out.push_back({"motion", "source", "string", 0, 0, "what poses the puppet: auto, gait, graph or graph_feet"});
+    out.push_back({"timing", "interpolation", "string", 0, 0, kInterpolationDoc});
     for (const std::string_view b : kButtonNames)
         out.push_back({"motion_graph.buttons", std::string(b), "string", 0.0, 0.0, "graph label played when the button is pressed, \"\" for none"});
     return out;
@@ -376,6 +383,10 @@ AppConfig apply_config_text(const AppConfig& base, std::string_view text, const 
             const std::string full = table_name + "." + std::string(key.str());
             if (table_name == "motion" && key.str() == "source") {
                 apply_motion_source(config, node, file);
+                continue;
+            }
+            if (table_name == "timing" && key.str() == "interpolation") {
+                apply_interpolation(app.timing, node, file);
                 continue;
             }
             if (table_name == "motion_graph" && key.str() == "buttons") {
@@ -423,7 +434,21 @@ void apply_motion_source(SimConfig& config, const toml::node& node, const std::s
                       (s ? "'" + s->get() + "' is not a motion source" : std::string("expected a string")) +
                           " (expected \"auto\", \"gait\", \"graph\" or \"graph_feet\")");
 }
+
+void apply_interpolation(TimingConfig& timing, const toml::node& node, const std::string& file) {
+    const auto* s = node.as_string();
+    for (std::size_t i = 0; s && i < std::size(kInterpolationNames); ++i)
+        if (s->get() == kInterpolationNames[i]) {
+            timing.interpolation = static_cast<Interpolation>(i);
+            return;
+        }
+    throw ConfigError(file, line_of(node), "timing.interpolation",
+                      (s ? "'" + s->get() + "' is not an interpolation" : std::string("expected a string")) +
+                          " (expected \"interpolate\", \"extrapolate\" or \"latest\")");
+}
 }  // namespace
+
+std::string interpolation_name(Interpolation mode) { return kInterpolationNames[static_cast<std::size_t>(mode)]; }
 
 std::string motion_source_name(MotionSourceSetting source) {
     return kMotionSourceNames[static_cast<std::size_t>(source)];

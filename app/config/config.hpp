@@ -39,6 +39,8 @@ std::vector<ConfigKeyInfo> config_schema();
 
 // "auto", "gait", "graph" or "graph_feet", as [motion] source spells it.
 std::string motion_source_name(MotionSourceSetting source);
+// [timing] interpolation: "interpolate", "extrapolate" or "latest".
+std::string interpolation_name(Interpolation mode);
 
 // Applies the TOML text on top of `base`. Throws ConfigError.
 AppConfig apply_config_text(const AppConfig& base, std::string_view toml_text, const std::string& file_name);

@@ -6,6 +6,7 @@
 #include <pthread.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <thread>
@@ -89,6 +90,9 @@ void SimulationLoop::run_tick(std::int64_t tick_time_ns, std::int64_t now_ns) {
     frame.current_time_ns = tick_time_ns;
     frame.connected = assembler_.connected();
     frame.tick_ns = 1'000'000'000 / sim_.config().tick_rate_hz;
+    input_stamps_[now.tick % kTickStampHistory] = {now.tick, assembler_.last_samples(), assembler_.last_oldest_ns(),
+                                                   assembler_.last_newest_ns(), now_ns};
+    frame.recent_inputs = input_stamps_;
     shared_.states.publish();
 
     record_.kind = TickRecord::Kind::tick;
@@ -108,15 +112,52 @@ vec3 FrameLoop::run_frame(std::int64_t frame_time_ns) {
     if (shared_.states.take()) has_state_ = true;
     if (!has_state_) return vec3(0.0f);
     const StateFrame& f = shared_.states.front();
-    // Render one tick behind: at the moment `current` was due, show `previous`,
-    // and reach `current` one tick later.
-    double alpha = static_cast<double>(frame_time_ns - f.current_time_ns) / static_cast<double>(f.tick_ns);
-    alpha = alpha < 0.0 ? 0.0 : (alpha > 1.0 ? 1.0 : alpha);
-    alpha_ = alpha;
-    const float a = static_cast<float>(alpha);
+    // s: how far past the current tick's time this frame is, in ticks.
+    double s = static_cast<double>(frame_time_ns - f.current_time_ns) / static_cast<double>(f.tick_ns);
+    s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+    switch (mode_) {
+        case Interpolation::interpolate:
+            // One tick behind: at the moment `current` was due, show `previous`,
+            // and reach `current` one tick later.
+            alpha_ = s;
+            shown_tick_ = s >= 1.0 ? f.current.tick : f.previous.tick;
+            break;
+        case Interpolation::extrapolate:
+            alpha_ = 1.0 + s;
+            shown_tick_ = f.current.tick;
+            break;
+        case Interpolation::latest:
+            alpha_ = 1.0;
+            shown_tick_ = f.current.tick;
+            break;
+    }
+    const float a = static_cast<float>(alpha_);
     const size_t n = static_cast<size_t>(f.current.joint_count);
     for (size_t j = 0; j < n; ++j) joints_[j] = lerp(f.previous.model_positions[j], f.current.model_positions[j], a);
     return lerp(f.previous.root_position, f.current.root_position, a);
+}
+
+void FrameLoop::presented(std::int64_t present_ns) {
+    if (!has_state_ || shown_tick_ <= last_presented_tick_) return;  // nothing new reached this frame
+    const TickStampHistory& recent = shared_.states.front().recent_inputs;
+    // The ticks this frame is the first to show; those older than the history are gone.
+    std::uint64_t from = last_presented_tick_ + 1;
+    if (shown_tick_ - last_presented_tick_ > kTickStampHistory) from = shown_tick_ - kTickStampHistory + 1;
+    last_presented_tick_ = shown_tick_;
+    bool any = false;
+    std::int64_t oldest = 0, newest = 0;
+    for (std::uint64_t t = from; t <= shown_tick_; ++t) {
+        const TickInputStamps& e = recent[t % kTickStampHistory];
+        if (e.tick != t || e.samples == 0) continue;
+        if (!any) oldest = e.oldest_ns;  // samples come in stamp order: the first tick's oldest is the oldest
+        any = true;
+        newest = e.newest_ns;
+    }
+    if (const TickInputStamps& shown = recent[shown_tick_ % kTickStampHistory]; shown.tick == shown_tick_)
+        present_.tick_to_present.add(present_ns - shown.ran_ns);
+    if (!any) return;
+    present_.oldest.add(present_ns - oldest);
+    present_.newest.add(present_ns - newest);
 }
 
 // ---------------------------------------------------------------- input scripts
@@ -134,7 +175,11 @@ InputScript script_from_program(const StickProgram& program, int rate, const std
     script.stamp_when_read = true;
     script.events.reserve(samples.size() + 2 * unplugged.size() + 2);
     bool was_unplugged = false;
-    // Sample n (one past the program) is the controller left at rest.
+    // Sample n (one past the program) is the controller left at rest. Like an
+    // evdev pad, the controller reports only changes: a sample equal to the one
+    // before is not sent (a tick without a new sample keeps the last values and
+    // held buttons, so the ticks' inputs are the same), and an idle stick wakes
+    // nothing (docs/pipeline.md, "Power").
     for (size_t i = 0; i <= samples.size(); ++i) {
         const std::int64_t t = static_cast<std::int64_t>(i) * period;
         const bool gone = is_unplugged(t);
@@ -145,7 +190,9 @@ InputScript script_from_program(const StickProgram& program, int rate, const std
             script.events.push_back(e);
         } else if (!gone) {
             e.input = i < samples.size() ? samples[i] : TickInput{};
-            script.events.push_back(e);
+            const bool repeat = !was_unplugged && !script.events.empty() && script.events.back().connected &&
+                                script.events.back().input == e.input;
+            if (!repeat) script.events.push_back(e);
         }
         was_unplugged = gone;
     }
@@ -291,11 +338,15 @@ struct RenderInputs {
     const Terrain* terrain = nullptr;
     float ankle_height = 0.08f;
     int tick_rate_hz = 240;
+    Interpolation interpolation = Interpolation::interpolate;
 };
 
+// Each frame is stamped when presented: the page flip's vblank time on KMS, after
+// the swap in a window, the frame loop's end headless (the frame's own time in
+// virtual time); `present` gets the latencies to those stamps.
 void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, RenderInputs in,
-                   DisplayThreadState& display, FrameTimeHistogram& frame_time) {
-    FrameLoop frames(sh);
+                   DisplayThreadState& display, FrameTimeHistogram& frame_time, PresentLatency& present) {
+    FrameLoop frames(sh, in.interpolation);
     std::unique_ptr<render::View> view;
     if (in.display->gl) {
         try {
@@ -330,9 +381,12 @@ void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, Ren
         const std::int64_t start = monotonic_ns();
         const std::int64_t at = virtual_time ? sh.states.front().current_time_ns : start;
         sink = sink + frames.run_frame(at).x;
+        std::int64_t presented_at = 0;  // the display's own stamp, when it gives one
         if (view && frames.has_state()) {
             const StateFrame& pair = frames.state_pair();
-            render::interpolate_state(pair.previous, pair.current, static_cast<float>(frames.alpha()), drawn);
+            const float alpha = static_cast<float>(frames.alpha());
+            if (alpha > 1.0f) render::extrapolate_state(pair.previous, pair.current, alpha - 1.0f, drawn);
+            else render::interpolate_state(pair.previous, pair.current, alpha, drawn);
             render::feet_overlay_from_state(drawn, *in.terrain, in.ankle_height, overlay);
             const PipelineCounters& c = sh.counters;
             const float speed = std::sqrt(drawn.velocity.x * drawn.velocity.x + drawn.velocity.y * drawn.velocity.y);
@@ -351,8 +405,10 @@ void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, Ren
                 display.closed.store(true, std::memory_order_release);
                 break;
             }
+            presented_at = r.present_ns;
         }
         const std::int64_t end = monotonic_ns();
+        frames.presented(virtual_time ? at : (presented_at > 0 ? presented_at : end));
         frame_time.add(end - start);
         if (end - start > window_max) window_max = end - start;
         sh.counters.frames.store(++count, std::memory_order_relaxed);
@@ -369,6 +425,7 @@ void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, Ren
             sh.counters.missed_frames.store(missed, std::memory_order_relaxed);
         }
     }
+    present = frames.present_latency();
 }
 
 const char* activity(float speed) {
@@ -405,10 +462,15 @@ std::string config_diff(const SimConfig& from, const SimConfig& to) {
     return out.empty() ? "no change" : out;
 }
 
-// How often the writer looks at its inputs (records, stop request, config file):
-// a 5 ms wait between looks keeps it off the CPU the simulation may share.
-constexpr int kWriterPollMs = 5;
-constexpr std::int64_t kWriterPollNs = std::int64_t{kWriterPollMs} * 1'000'000;
+// How often the writer looks at its inputs (records, stop request, config file).
+// In real time nothing it does is urgent: a stop signal cuts the wait short (the
+// workers block SIGINT/SIGTERM, so it reaches this thread, and poll() is never
+// restarted), an edit wakes it through inotify, and the record ring holds 68 s;
+// so it waits 50 ms at a time, 20 wake-ups a second (docs/pipeline.md, "Power").
+// In virtual time the simulation may be waiting for room in the ring, and once
+// stopping the threads are about to end: 5 ms then.
+constexpr int kWriterPollMs = 50;
+constexpr int kWriterPollShortMs = 5;
 // Editors write in steps: a watched file is read once it has been quiet this long.
 constexpr std::int64_t kEditQuietNs = 100'000'000;
 // A log chunk is written at least this often while ticks are pending (real time).
@@ -423,6 +485,7 @@ struct LiveTuning {
     std::unique_ptr<ConfigWatcher> watcher;
     SimConfig published;       // the newest configuration handed over
     RealtimeConfig realtime;   // the thread settings the run started with (fixed)
+    TimingConfig timing;       // what the render thread draws (fixed)
     // Only its fixed-after-start part is read (motion_source_allowed), so this
     // thread may ask it while the simulation thread steps.
     const Simulation* simulation = nullptr;
@@ -432,15 +495,17 @@ struct LiveTuning {
     std::vector<SimConfig> history;
     std::int64_t dirty_since = -1;
 
-    // Waits up to kWriterPollMs for an edit of the watched file (without one,
+    // Waits up to `wait_ms` for an edit of the watched file (without one,
     // just waits) and hands the file over once it has been quiet for kEditQuietNs.
-    void wait_and_poll(PipelineShared& sh, std::FILE* err) {
+    void wait_and_poll(PipelineShared& sh, std::FILE* err, int wait_ms) {
         if (!watcher) {
-            sleep_until_ns(monotonic_ns() + kWriterPollNs);
+            poll(nullptr, 0, wait_ms);  // a signal ends it early (EINTR)
             return;
         }
+        // An edit in progress is looked at again once it has been quiet long enough.
+        if (dirty_since >= 0) wait_ms = std::min<int>(wait_ms, static_cast<int>(kEditQuietNs / 1'000'000));
         pollfd p{watcher->fd(), POLLIN, 0};
-        if (poll(&p, 1, kWriterPollMs) > 0 && watcher->read_events()) dirty_since = monotonic_ns();
+        if (poll(&p, 1, wait_ms) > 0 && watcher->read_events()) dirty_since = monotonic_ns();
         if (dirty_since >= 0 && monotonic_ns() - dirty_since >= kEditQuietNs) {
             dirty_since = -1;
             reload(sh, err);
@@ -457,6 +522,7 @@ struct LiveTuning {
         }
         Outcome kept = structure_unchanged(published, next.sim);
         if (kept.ok() && !(next.realtime == realtime)) kept = Outcome::failure("realtime (thread settings)");
+        if (kept.ok() && !(next.timing == timing)) kept = Outcome::failure("timing.interpolation");
         if (kept.ok() && simulation) kept = simulation->motion_source_allowed(next.sim);
         if (!kept.ok()) {
             log_message(LogLevel::warning, fmt::format("config: {}: {} cannot change while running (restart to apply it); keeping the previous configuration",
@@ -667,7 +733,8 @@ public:
             }
             notifier_.poll(now, sh_.counters.simulation_heartbeat.load(std::memory_order_relaxed),
                            sh_.counters.frames.load(std::memory_order_relaxed));
-            tuning_.wait_and_poll(sh_, o_.err);
+            const bool hurry = o_.virtual_time || sh_.stop.load(std::memory_order_relaxed);
+            tuning_.wait_and_poll(sh_, o_.err, hurry ? kWriterPollShortMs : kWriterPollMs);
         }
     }
 
@@ -699,6 +766,7 @@ private:
         LiveTuning tuning;
         tuning.published = o.config;
         tuning.realtime = o.realtime;
+        tuning.timing.interpolation = o.interpolation;
         tuning.simulation = &sim;
         if (!o.watch_config_file.empty()) tuning.watcher = std::make_unique<ConfigWatcher>(o.watch_config_file);
         return tuning;
@@ -726,9 +794,9 @@ private:
     void start_display() {
         const Simulation& sim = loop_->simulation();
         const RenderInputs inputs{&o_.display, &sim.skeleton(), &sim.terrain(), o_.config.ankle_height,
-                                  o_.config.tick_rate_hz};
+                                  o_.config.tick_rate_hz, o_.interpolation};
         gfx_thread_ = std::thread(render_thread, std::ref(sh_), o_.frame_rate_hz, o_.virtual_time, inputs,
-                                  std::ref(display_), std::ref(result_.frame_time));
+                                  std::ref(display_), std::ref(result_.frame_time), std::ref(result_.present_latency));
         while (display_.state.load(std::memory_order_acquire) == DisplayThreadState::opening)
             sleep_until_ns(monotonic_ns() + kDisplayOpenPollNs);
         if (display_.state.load(std::memory_order_acquire) == DisplayThreadState::failed) {
@@ -780,6 +848,7 @@ private:
         r.final_hash = hash_state(r.final_state);
         r.input_latency = loop_->input_latency();
         r.tick_time = sim_result_.tick_time;
+        r.interpolation = o_.interpolation;
         r.samples_pushed = sh_.counters.samples_pushed.load();
         r.samples_dropped = sh_.counters.samples_dropped.load();
         r.frames = sh_.counters.frames.load();

@@ -38,6 +38,21 @@ inline constexpr int kSimulatedControllerHz = 1000;
 
 using InputRing = SpscRing<TimedInput, kInputRingCapacity>;
 
+// The input that reached one tick: how many samples it consumed, the stamps of
+// the oldest and newest of them, and when it ran. A frame names, through these,
+// the samples it is the first to show (FrameLoop::presented).
+struct TickInputStamps {
+    std::uint64_t tick = 0;     // the state's tick number after the step (0: no tick yet)
+    std::uint32_t samples = 0;  // 0: none consumed (the stamps are unset)
+    std::int64_t oldest_ns = 0;
+    std::int64_t newest_ns = 0;
+    std::int64_t ran_ns = 0;    // when the tick ran
+};
+// The newest ticks' entries, by tick % size: 133 ms at 240 Hz, far more than the
+// ticks between two frames (a frame that comes later than that counts the rest).
+inline constexpr std::size_t kTickStampHistory = 32;
+using TickStampHistory = std::array<TickInputStamps, kTickStampHistory>;
+
 // What the render thread interpolates between: the two latest ticks.
 struct StateFrame {
     PuppetState previous;
@@ -45,6 +60,7 @@ struct StateFrame {
     std::int64_t current_time_ns = 0;  // when `current`'s tick was due
     std::int64_t tick_ns = 0;
     bool connected = true;             // the controller, for the on-screen notice
+    TickStampHistory recent_inputs{};  // the input that reached `current` and the ticks before it
 };
 
 // Simulation → writer, per tick (and per configuration change, in order).
@@ -142,29 +158,59 @@ private:
     InputLatencyHistogram latency_;
     std::int64_t latency_window_max_ns_ = 0;
     std::uint64_t config_changes_ = 0;
+    TickStampHistory input_stamps_{};  // copied into every published state pair
     TickRecord record_{};  // reused, so the tick builds no large temporaries
 };
 
-// The render thread's work for one frame: take the newest state pair and
-// interpolate it by alpha = (frame time − one tick − previous tick time) / dt,
-// i.e. one tick behind, so a frame never extrapolates. (The GLES renderer draws
-// from `joints()` once it lands.)
+// Sample stamp → the frame that first showed it was presented: 10 µs buckets up to 100 ms.
+using PresentLatencyHistogram = DurationHistogram<10'000, 10'000>;
+
+// End-to-end latency, per frame that showed new input: from the oldest and the
+// newest sample that reached it (through the ticks it is the first to show) to
+// its presentation, and from the newest tick it shows having run to then.
+struct PresentLatency {
+    PresentLatencyHistogram oldest;
+    PresentLatencyHistogram newest;
+    PresentLatencyHistogram tick_to_present;
+};
+
+// The render thread's work for one frame: take the newest state pair and pose
+// the puppet from it, by [timing] interpolation (app_config.hpp). With s = (frame
+// time − the current tick's time) / dt, clamped to [0, 1]:
+//   interpolate — alpha = s between the previous and the current state: one tick
+//                 behind, never extrapolating; a tick is shown in full once s = 1;
+//   extrapolate — alpha = 1 + s: the current state carried on along the last
+//                 tick's motion, at most one tick ahead;
+//   latest      — alpha = 1: the current state as it is.
+// Then presented() stamps the frame. (The GLES renderer draws from the pair with
+// render::interpolate_state / extrapolate_state.)
 class FrameLoop {
 public:
-    explicit FrameLoop(PipelineShared& shared) : shared_(shared) {}
-    // Returns the interpolated root position.
+    explicit FrameLoop(PipelineShared& shared, Interpolation mode = Interpolation::interpolate)
+        : shared_(shared), mode_(mode) {}
+    // Returns the posed root position.
     vec3 run_frame(std::int64_t frame_time_ns);
+    // The frame run_frame() posed was presented (shown, or ready, headless) at
+    // `present_ns`: adds its latencies when it shows ticks no frame showed before.
+    void presented(std::int64_t present_ns);
     bool has_state() const { return has_state_; }
-    double alpha() const { return alpha_; }
-    // The state pair the last run_frame() interpolated (valid once has_state()).
+    double alpha() const { return alpha_; }  // 0 … 2 (above 1: extrapolated)
+    // The newest tick the last frame shows in full.
+    std::uint64_t shown_tick() const { return shown_tick_; }
+    // The state pair the last run_frame() posed (valid once has_state()).
     const StateFrame& state_pair() const { return shared_.states.front(); }
     const std::array<vec3, kMaxJoints>& joints() const { return joints_; }
+    const PresentLatency& present_latency() const { return present_; }
 
 private:
     PipelineShared& shared_;
+    Interpolation mode_;
     bool has_state_ = false;
     double alpha_ = 0.0;
+    std::uint64_t shown_tick_ = 0;
+    std::uint64_t last_presented_tick_ = 0;  // the newest tick an earlier frame showed
     std::array<vec3, kMaxJoints> joints_{};
+    PresentLatency present_;
 };
 
 // Where the input thread's samples come from, prepared before it starts:
@@ -222,6 +268,7 @@ struct PipelineOptions {
     // waiting for every sample up to its time, so the run is deterministic.
     bool virtual_time = false;
     int frame_rate_hz = 60;            // the headless frame loop's pace
+    Interpolation interpolation = Interpolation::interpolate;  // [timing]: what the render thread draws
     DisplayOptions display;
     std::string record_file;           // input log ("" = none): its first file (app/live/recording.hpp)
     std::string record_rotate_dir;     // --record auto: keep the [recording] limits by deleting the oldest here
@@ -251,6 +298,8 @@ struct PipelineResult {
     InputLatencyHistogram input_latency;
     TickTimeHistogram tick_time;
     FrameTimeHistogram frame_time;
+    PresentLatency present_latency;
+    Interpolation interpolation = Interpolation::interpolate;  // what the frames showed
     std::uint64_t samples_pushed = 0;
     std::uint64_t samples_dropped = 0;
     std::uint64_t frames = 0;

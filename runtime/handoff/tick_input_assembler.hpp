@@ -88,6 +88,7 @@ public:
     TickInput assemble(Ring& ring, std::int64_t tick_time_ns, std::int64_t now_ns, InputLatencyHistogram& latency) {
         std::uint32_t buttons = 0;
         bool any = false;
+        last_samples_ = 0;
         while (const TimedInput* next = ring.peek()) {
             if (next->timestamp_ns > tick_time_ns) break;
             TimedInput sample;
@@ -104,6 +105,8 @@ public:
             buttons |= sample.input.buttons;
             any = true;
             latency.add(now_ns - sample.timestamp_ns);
+            if (last_samples_++ == 0) last_oldest_ns_ = sample.timestamp_ns;
+            last_newest_ns_ = sample.timestamp_ns;
         }
         TickInput out = latest_;
         // With no new sample the last state holds: buttons still held stay held.
@@ -112,12 +115,20 @@ public:
     }
 
     bool connected() const { return connected_; }
+    // The samples the last assemble() consumed (disconnect markers aside), and
+    // the stamps of its oldest and newest (valid when the count is > 0).
+    std::uint32_t last_samples() const { return last_samples_; }
+    std::int64_t last_oldest_ns() const { return last_oldest_ns_; }
+    std::int64_t last_newest_ns() const { return last_newest_ns_; }
     std::uint64_t disconnects() const { return disconnects_; }
     std::uint64_t reconnects() const { return reconnects_; }
 
 private:
     TickInput latest_{};
     bool connected_ = true;
+    std::uint32_t last_samples_ = 0;
+    std::int64_t last_oldest_ns_ = 0;
+    std::int64_t last_newest_ns_ = 0;
     std::uint64_t disconnects_ = 0;
     std::uint64_t reconnects_ = 0;
 };

@@ -227,3 +227,137 @@ TEST_CASE("the frame loop interpolates one tick behind and never past the newest
     CHECK(frames.run_frame(5000).x == 1.0f);     // late frames hold the newest state
     CHECK(frames.run_frame(0).x == 0.0f);        // and early ones the previous, never extrapolating
 }
+
+TEST_CASE("the frame loop's three interpolations: one tick behind, carried ahead, the newest as it is", "[pipeline]") {
+    struct Expected {
+        Interpolation mode;
+        float at_tick, quarter, late;         // root x at the current tick's time, a quarter tick on, 40 ticks on
+        std::uint64_t shown_at_tick, shown_late;
+    };
+    // previous (tick 6) at x = 0, current (tick 7) at x = 1.
+    const Expected cases[] = {{Interpolation::interpolate, 0.0f, 0.25f, 1.0f, 6, 7},
+                              {Interpolation::extrapolate, 1.0f, 1.25f, 2.0f, 7, 7},
+                              {Interpolation::latest, 1.0f, 1.0f, 1.0f, 7, 7}};
+    for (const Expected& e : cases) {
+        INFO("mode " << interpolation_name(e.mode));
+        auto shared = std::make_unique<PipelineShared>();
+        FrameLoop frames(*shared, e.mode);
+        StateFrame& f = shared->states.back();
+        f.previous.root_position = vec3(0.0f);
+        f.previous.tick = 6;
+        f.current.root_position = vec3(1.0f, 0.0f, 0.0f);
+        f.current.tick = 7;
+        f.current_time_ns = 1000;
+        f.tick_ns = 100;
+        shared->states.publish();
+        CHECK(frames.run_frame(1000).x == e.at_tick);
+        CHECK(frames.shown_tick() == e.shown_at_tick);
+        CHECK(frames.run_frame(1025).x == e.quarter);
+        CHECK(frames.run_frame(5000).x == e.late);  // never more than one tick ahead
+        CHECK(frames.shown_tick() == e.shown_late);
+        CHECK(frames.run_frame(0).x == e.at_tick);  // never before the pair
+    }
+}
+
+namespace {
+// Publishes the pair (tick − 1, tick) with the history entry of `tick`.
+void publish_tick(PipelineShared& sh, TickStampHistory& history, std::uint64_t tick, std::uint32_t samples,
+                  std::int64_t oldest, std::int64_t newest, std::int64_t ran) {
+    history[tick % kTickStampHistory] = {tick, samples, oldest, newest, ran};
+    StateFrame& f = sh.states.back();
+    f.previous.tick = tick - 1;
+    f.current.tick = tick;
+    f.current_time_ns = static_cast<std::int64_t>(tick) * 1000;
+    f.tick_ns = 1000;
+    f.recent_inputs = history;
+    sh.states.publish();
+}
+}  // namespace
+
+TEST_CASE("a presented frame counts the oldest and newest sample of every tick it is the first to show",
+          "[pipeline]") {
+    auto shared = std::make_unique<PipelineShared>();
+    TickStampHistory history{};
+    FrameLoop frames(*shared, Interpolation::latest);
+    // Ticks 1–4 between two frames (ms): tick 2 consumed nothing; tick 3 was overwritten before a frame read it.
+    publish_tick(*shared, history, 1, 3, 100'000, 300'000, 1'000'000);
+    frames.run_frame(1'000);
+    frames.presented(2'000'000);  // shows tick 1: oldest 1.9 ms, newest 1.7 ms ago
+    publish_tick(*shared, history, 2, 0, 0, 0, 2'000'000);
+    publish_tick(*shared, history, 3, 2, 2'100'000, 2'500'000, 3'000'000);
+    publish_tick(*shared, history, 4, 1, 3'600'000, 3'600'000, 4'000'000);
+    frames.run_frame(4'000);
+    frames.presented(6'000'000);  // shows ticks 2–4 for the first time: oldest 2.1 ms, newest 3.6 ms
+    frames.run_frame(4'500);
+    frames.presented(7'000'000);  // the same tick again: nothing new reached this frame
+    const PresentLatency& p = frames.present_latency();
+    REQUIRE(p.oldest.count == 2);
+    CHECK(p.oldest.max_ns == 6'000'000 - 2'100'000);
+    CHECK(p.oldest.sum_ns == (2'000'000 - 100'000) + (6'000'000 - 2'100'000));
+    CHECK(p.newest.sum_ns == (2'000'000 - 300'000) + (6'000'000 - 3'600'000));
+    CHECK(p.tick_to_present.sum_ns == (2'000'000 - 1'000'000) + (6'000'000 - 4'000'000));
+
+    // Interpolating one tick behind, tick 5 reaches the screen only once the frame is a tick past it.
+    FrameLoop behind(*shared, Interpolation::interpolate);
+    publish_tick(*shared, history, 5, 1, 4'500'000, 4'500'000, 5'000'000);
+    behind.run_frame(5'000);         // shows tick 4 (and, first for this loop, ticks 1–3)
+    behind.presented(5'100'000);
+    behind.run_frame(6'000);         // s = 1: tick 5 in full
+    behind.presented(6'100'000);
+    REQUIRE(behind.present_latency().newest.count == 2);
+    CHECK(behind.present_latency().newest.max_ns == 6'100'000 - 4'500'000);
+    CHECK(behind.present_latency().oldest.max_ns == 5'100'000 - 100'000);  // tick 1's oldest, still in the history
+}
+
+TEST_CASE("the interpolation choice changes what is drawn, never the ticks, hashes or recording", "[pipeline]") {
+    const SimConfig config = default_config().sim;
+    const StickProgram program = parse_stick_program("circle 2s radius=1 turns=1\npress south 50ms\nhold 500ms ly=-1\n",
+                                                     "c.prog");
+    std::vector<std::vector<std::uint8_t>> logs;
+    std::vector<std::uint64_t> hashes;
+    for (const Interpolation mode : {Interpolation::interpolate, Interpolation::extrapolate, Interpolation::latest}) {
+        INFO("mode " << interpolation_name(mode));
+        PipelineOptions o = virtual_run(config, script_from_program(program, kSimulatedControllerHz), 3 * 240);
+        o.interpolation = mode;
+        o.record_file = temp_path("interp_" + interpolation_name(mode) + ".mlog");
+        const PipelineResult r = run_pipeline(o);
+        CHECK(r.interpolation == mode);
+        CHECK(r.ticks == 3 * 240);
+        CHECK(r.frames > 0);
+        logs.push_back(read_binary_file(o.record_file));
+        hashes.push_back(r.final_hash);
+        std::remove(o.record_file.c_str());
+    }
+    CHECK(logs[0] == logs[1]);
+    CHECK(logs[0] == logs[2]);
+    CHECK(hashes[0] == hashes[1]);
+    CHECK(hashes[0] == hashes[2]);
+}
+
+TEST_CASE("a real-time run reports input to present per frame, ordered and after input to tick", "[pipeline]") {
+    const SimConfig config = default_config().sim;
+    const StickProgram program = parse_stick_program("circle 2s radius=1 turns=1\n", "c.prog");
+    for (const Interpolation mode : {Interpolation::interpolate, Interpolation::latest}) {
+        INFO("mode " << interpolation_name(mode));
+        PipelineOptions o;
+        o.config = config;
+        o.script = script_from_program(program, kSimulatedControllerHz);
+        o.total_ticks = 240 + 120;  // 1.5 s
+        o.status_lines = false;
+        o.interpolation = mode;
+        const PipelineResult r = run_pipeline(o);
+        const PresentLatency& p = r.present_latency;
+        REQUIRE(p.oldest.count > 10);
+        CHECK(p.newest.count == p.oldest.count);
+        for (const PresentLatencyHistogram* h : {&p.oldest, &p.newest, &p.tick_to_present}) {
+            CHECK(h->quantile_ns(0.5) <= h->quantile_ns(0.99));
+            CHECK(h->quantile_ns(0.99) <= h->max_ns);
+        }
+        // Per frame the oldest sample waited at least as long as the newest.
+        CHECK(p.newest.quantile_ns(0.5) <= p.oldest.quantile_ns(0.5));
+        CHECK(p.newest.max_ns <= p.oldest.max_ns);
+        // Each sample is presented after its tick ran, and a frame's oldest sample is its worst.
+        CHECK(p.oldest.quantile_ns(0.5) >= r.input_latency.quantile_ns(0.5));
+        CHECK(p.oldest.quantile_ns(0.99) >= r.input_latency.quantile_ns(0.5));
+    }
+}

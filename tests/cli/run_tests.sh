@@ -24,6 +24,29 @@ for key in '"ticks":720' '"tick_time_us":{"p50":' '"input_to_tick_latency_us":{"
 done
 hash=$(sed -E 's/.*"final_hash":"([0-9a-f]+)".*/\1/' stats.json)
 check "stats json final hash equals the replay's" test "$hash" = "$("$bin" replay run.mlog --hash)"
+check "stats json has input_to_present_ms, ordered, after input_to_tick" python3 -c '
+import json, sys
+d = json.load(open("stats.json"))
+p, t = d["input_to_present_ms"], d["input_to_tick_latency_us"]
+assert d["interpolation"] == "interpolate" and p["frames"] > 0, d
+for h in (p["oldest"], p["newest"], d["tick_to_present_ms"]):
+    assert h["p50"] <= h["p99"] <= h["max"], h
+assert p["newest"]["p50"] <= p["oldest"]["p50"] and p["newest"]["max"] <= p["oldest"]["max"], p
+assert p["oldest"]["p50"] >= t["p50"] / 1000, (p, t)
+'
+
+# [timing] interpolation changes only what is drawn: the same recording in each mode.
+for mode in interpolate extrapolate latest; do
+  printf '[timing]\ninterpolation = "%s"\n' "$mode" >timing_$mode.toml
+  "$bin" run --fast --config timing_$mode.toml --input "sim:$src/config/programs/circle.prog" --record timing_$mode.mlog \
+    --stats-json timing_$mode.json >/dev/null
+  check "[timing] $mode: reported" grep -qF "\"interpolation\":\"$mode\"" timing_$mode.json
+done
+check "[timing] extrapolate records what interpolate does" cmp -s timing_interpolate.mlog timing_extrapolate.mlog
+check "[timing] latest records what interpolate does" cmp -s timing_interpolate.mlog timing_latest.mlog
+printf '[timing]\ninterpolation = "ahead"\n' >timing_bad.toml
+expect_error "[timing] an unknown interpolation is refused" 2 "timing.interpolation: 'ahead' is not an interpolation" \
+  "$bin" run --fast --config timing_bad.toml --input "sim:$src/config/programs/circle.prog"
 
 # Virtual time (--fast) is deterministic: two runs record the same log.
 "$bin" run --fast --input "sim:$src/config/programs/demo.prog" --record f1.mlog >/dev/null

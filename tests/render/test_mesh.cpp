@@ -138,6 +138,35 @@ TEST_CASE("interpolation: alpha 0 and 1 give the ticks, positions lerp, rotation
     CHECK(out.root_position == b.root_position);
 }
 
+TEST_CASE("extrapolation carries the newest tick on along the last tick's motion, at most one tick", "[render][interpolate]") {
+    PuppetState a;
+    PuppetState b;
+    a.joint_count = b.joint_count = 2;
+    a.tick = 10;
+    b.tick = 11;
+    a.root_position = vec3(0.0f, 0.0f, 1.0f);
+    b.root_position = vec3(1.0f, 0.0f, 3.0f);
+    a.model_rotations[1] = quat_identity();
+    b.model_rotations[1] = quat_axis_angle(vec3(0, 1, 0), 0.4);
+    a.heading = 3.0f;
+    b.heading = -3.0f;  // 0.28 rad apart across ±π
+    PuppetState out;
+    extrapolate_state(a, b, 0.0f, out);
+    CHECK(out.root_position == b.root_position);
+    CHECK(out.tick == 11);
+    extrapolate_state(a, b, 0.5f, out);
+    CHECK(out.root_position.x == Approx(1.5f));
+    CHECK(out.root_position.z == Approx(4.0f));
+    CHECK(quat_angle_between(out.model_rotations[1], quat_identity()) == Approx(0.6).margin(1e-5));
+    // Half a tick on along the short arc (0.28 rad per tick), as an angle.
+    const double expected_heading = -3.0 + 0.5 * (2.0 * 3.14159265358979 - 6.0);
+    CHECK(std::remainder(out.heading - expected_heading, 2.0 * 3.14159265358979) == Approx(0.0).margin(1e-5));
+    extrapolate_state(a, b, 7.0f, out);    // clamped to one tick ahead
+    CHECK(out.root_position.x == Approx(2.0f));
+    extrapolate_state(a, b, -1.0f, out);   // never behind the newest tick
+    CHECK(out.root_position == b.root_position);
+}
+
 TEST_CASE("follow camera snaps first, then eases toward the puppet with its time constant", "[render][camera]") {
     CameraSettings s;
     s.smoothing_s = 0.5f;
