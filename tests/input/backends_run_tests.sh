@@ -8,8 +8,9 @@
 #   plain:  umockdev-run plays the script; `run --record --trace`; the recording
 #           replays to exactly the run's trace; the puppet walked as the program
 #           says (check_walk.py against the simulated controller's trace);
-#   replug: umockdev_replug plays the first leg, unplugs the pad (hang-up, node
-#           removed), plugs one in on the next node and plays the second leg; the
+#   replug: umockdev_replug plays the first leg, unplugs the pad (hang-up,
+#           "remove" uevent, node removed), plugs one in on the next node ("add")
+#           and plays the second leg; the
 #           run keeps going, logs both, counts 1 disconnect and 1 reconnect, the
 #           replay matches, and each leg went the program's way.
 # Usage: backends_run_tests.sh MARIONETTE SOURCE_DIR UMOCKDEV_WRAPPER UMOCKDEV_REPLUG
@@ -55,10 +56,11 @@ for spec in \
   "sdl|sdl|evemu|dualsense|dualsense.umockdev|/dev/input/event9|dualsense.ioctl|/dev/input/event10|s/event9/event10/g;s/input9/input10/g;s/13:73/13:74/;s/MINOR=73/MINOR=74/"; do
   IFS='|' read -r backend shown format pad desc node ioctl node2 rename <<<"$spec"
   b=$backend
-  # Plain: the first leg after 1.5 s (the run has opened the node by then).
-  firmware "$format" "$pad" leg1.prog "$b.plain.script" 1500
+  # Plain: the first leg after 2.5 s (the run has opened the node by then, and
+  # SDL2 has closed the node it only probed: a pty's last close drops what it holds).
+  firmware "$format" "$pad" leg1.prog "$b.plain.script" 2500
   timeout 40 umockdev-run -d "$data/$desc" -i "$node=$data/$ioctl" -s "$node=$b.plain.script" -- \
-    "$bin" run --input "$backend" --duration 4 --display headless --record "$b.mlog" --trace "$b.csv" \
+    "$bin" run --input "$backend" --duration 5.5 --display headless --record "$b.mlog" --trace "$b.csv" \
     --stats-json "$b.json" >"$b.out" 2>"$b.err"
   rc=$?
   check "$b: run exits 0 (rc $rc: $(grep -v WARNING "$b.err" | grep -v '^$' | tail -2))" test $rc -eq 0
@@ -72,21 +74,14 @@ for spec in \
     python3 "$src/tests/input/check_walk.py" "$b.csv" ref.csv --ref-cuts 3.0 --ref-legs 1
   python3 "$src/tests/input/check_walk.py" "$b.csv" ref.csv --ref-cuts 3.0 --ref-legs 1 | sed "s/^/$b plain: /"
 
-  # SDL2's hot-plug cannot be driven under umockdev here: umockdev 0.17's
-  # "remove" uevent never reaches a libudev monitor (a plain libudev probe gets
-  # the replugged node's "add" events, nothing for the removal), and SDL 2.26
-  # closes a joystick only when a read fails with ENODEV, while umockdev's
-  # pty-backed node fails with EIO. SDL then keeps the old pad open and takes
-  # the new node for a second joystick. So no SDL replug here (docs/input.md).
-  [[ $backend == sdl ]] && continue
-  # Replug: leg 1 (1.5 s lead), unplugged at 5 s, the next node at 6 s, leg 2 1 s later.
-  firmware "$format" "$pad" leg1.prog "$b.leg1.script" 1500
+  # Replug: leg 1 (2.5 s lead), unplugged at 6 s, the next node at 7 s, leg 2 1 s later.
+  firmware "$format" "$pad" leg1.prog "$b.leg1.script" 2500
   firmware "$format" "$pad" leg2.prog "$b.leg2.script" 1000
   if [[ $backend == hidapi ]]; then cp "$data/dualsense_hidraw_replugged.umockdev" "$b.replugged.umockdev"
   else sed "$rename" "$data/$desc" >"$b.replugged.umockdev"; fi
-  timeout 60 "$wrapper" "$replug" "$data/$desc" "$node" "$data/$ioctl" "$b.leg1.script" 5 \
-    "$b.replugged.umockdev" "$node2" "$b.leg2.script" 6 -- \
-    "$bin" run --input "$backend" --duration 9.5 --display headless --record "$b.r.mlog" --trace "$b.r.csv" \
+  timeout 60 "$wrapper" "$replug" "$data/$desc" "$node" "$data/$ioctl" "$b.leg1.script" 6 \
+    "$b.replugged.umockdev" "$node2" "$b.leg2.script" 7 -- \
+    "$bin" run --input "$backend" --duration 10.5 --display headless --record "$b.r.mlog" --trace "$b.r.csv" \
     --stats-json "$b.r.json" >"$b.r.out" 2>"$b.r.err"
   rc=$?
   check "$b replug: run exits 0 (rc $rc: $(grep -v WARNING "$b.r.err" | grep -v '^$' | tail -2))" test $rc -eq 0

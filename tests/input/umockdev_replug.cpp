@@ -107,6 +107,9 @@ int main(int argc, char** argv) {
         close(fd);
         unlink(map.c_str());
     }
+    // umockdev 0.17's remove_device sends no uevent (later versions do): send
+    // the kernel's "remove" first, while the device's properties are still there.
+    umockdev_testbed_uevent(bed, syspath.c_str(), "remove");
     umockdev_testbed_remove_device(bed, syspath.c_str());
     std::fprintf(stderr, "umockdev_replug: %.2f s: %s unplugged\n",
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), node);
