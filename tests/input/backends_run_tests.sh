@@ -39,10 +39,12 @@ printf 'hold 1200ms ly=0.9\nhold 3000ms ly=0\nhold 1200ms lx=0.9\nhold 2000ms lx
 "$bin" run --fast --display headless --input sim:ref.prog --trace ref.csv >/dev/null
 
 # firmware FORMAT PAD PROGRAM OUT LEAD_MS: the umockdev script of a sim-pad run.
+# HID reports at 125 Hz: umockdev sleeps before each read, and on a loaded machine
+# every sleep overshoots, so fewer reads stretch a program less.
 firmware() {
   if [[ $1 == hid ]]; then
-    "$bin" sim-pad --format dualsense --rate 250 --program "$3" --out "$4.bin" >/dev/null &&
-      python3 "$src/tests/input/umockdev_script.py" hid "$4.bin" "$4" --rate 250 --report-size 64 --lead "$5"
+    "$bin" sim-pad --format dualsense --rate 125 --program "$3" --out "$4.bin" >/dev/null &&
+      python3 "$src/tests/input/umockdev_script.py" hid "$4.bin" "$4" --rate 125 --report-size 64 --lead "$5"
   else
     "$bin" sim-pad --format evemu --pad "$2" --rate 1000 --program "$3" --out "$4.events" >/dev/null &&
       python3 "$src/tests/input/umockdev_script.py" evemu "$4.events" "$4" --lead "$5"
@@ -65,23 +67,25 @@ for spec in \
   rc=$?
   check "$b: run exits 0 (rc $rc: $(grep -v WARNING "$b.err" | grep -v '^$' | tail -2))" test $rc -eq 0
   check "$b: run reads the controller through $shown" grep -q "controller ($shown)" "$b.out"
-  # evdev sends a frame only when something changed (2 here); hidraw every report (375).
+  # evdev sends a frame only when something changed (2 here); hidraw every report (188).
   check "$b: the pad's samples reached the simulation ($(stat_of "$b.json" samples) samples)" \
-    test "$(stat_of "$b.json" samples)" -ge "$([[ $format == hid ]] && echo 100 || echo 2)"
+    test "$(stat_of "$b.json" samples)" -ge "$([[ $format == hid ]] && echo 50 || echo 2)"
+  echo "$b plain: $(stat_of "$b.json" samples) samples, $(stat_of "$b.json" ticks) ticks, $(grep -c . "$b.csv") trace lines"
   "$bin" replay "$b.mlog" --trace "$b.replay.csv" >/dev/null 2>&1
   check "$b: replay of the recording gives exactly the run's trace" cmp -s "$b.csv" "$b.replay.csv"
   check "$b: the puppet walked forward as the program says" \
     python3 "$src/tests/input/check_walk.py" "$b.csv" ref.csv --ref-cuts 3.0 --ref-legs 1
   python3 "$src/tests/input/check_walk.py" "$b.csv" ref.csv --ref-cuts 3.0 --ref-legs 1 | sed "s/^/$b plain: /"
 
-  # Replug: leg 1 (2.5 s lead), unplugged at 6 s, the next node at 7 s, leg 2 1 s later.
+  # Replug: leg 1 (2.5 s lead), unplugged at 7 s (umockdev 0.17 cannot wait for a
+  # script to end, and the leg may run late), the next node at 8 s, leg 2 1 s later.
   firmware "$format" "$pad" leg1.prog "$b.leg1.script" 2500
   firmware "$format" "$pad" leg2.prog "$b.leg2.script" 1000
   if [[ $backend == hidapi ]]; then cp "$data/dualsense_hidraw_replugged.umockdev" "$b.replugged.umockdev"
   else sed "$rename" "$data/$desc" >"$b.replugged.umockdev"; fi
-  timeout 60 "$wrapper" "$replug" "$data/$desc" "$node" "$data/$ioctl" "$b.leg1.script" 6 \
-    "$b.replugged.umockdev" "$node2" "$b.leg2.script" 7 -- \
-    "$bin" run --input "$backend" --duration 10.5 --display headless --record "$b.r.mlog" --trace "$b.r.csv" \
+  timeout 60 "$wrapper" "$replug" "$data/$desc" "$node" "$data/$ioctl" "$b.leg1.script" 7 \
+    "$b.replugged.umockdev" "$node2" "$b.leg2.script" 8 -- \
+    "$bin" run --input "$backend" --duration 11.5 --display headless --record "$b.r.mlog" --trace "$b.r.csv" \
     --stats-json "$b.r.json" >"$b.r.out" 2>"$b.r.err"
   rc=$?
   check "$b replug: run exits 0 (rc $rc: $(grep -v WARNING "$b.r.err" | grep -v '^$' | tail -2))" test $rc -eq 0
@@ -89,6 +93,9 @@ for spec in \
   check "$b replug: the replug is logged" grep -q "controller connected: resuming" "$b.r.out"
   check "$b replug: 1 disconnect and 1 reconnect counted" \
     test "$(stat_of "$b.r.json" disconnects)/$(stat_of "$b.r.json" reconnects)" = 1/1
+  echo "$b replug: $(stat_of "$b.r.json" samples) samples, $(stat_of "$b.r.json" ticks) ticks," \
+    "$(stat_of "$b.r.json" disconnects) disconnect(s), $(stat_of "$b.r.json" reconnects) reconnect(s);" \
+    "$(grep -E 'controller (dis)?connected' "$b.r.out" | tr '\n' ';')"
   "$bin" replay "$b.r.mlog" --trace "$b.r.replay.csv" >/dev/null 2>&1
   check "$b replug: replay of the recording gives exactly the run's trace" cmp -s "$b.r.csv" "$b.r.replay.csv"
   # Cut the run's travel where the pad went away.

@@ -7,10 +7,11 @@ Travel is cut into legs at the given seconds (e.g. where a pad was unplugged):
 leg i runs from cut i-1 (or the first tick) to cut i (or the last tick). For
 each leg with a reference travel of at least 0.5 m the run's travel must point
 the same way (within --max-angle degrees on the ground plane) and be between
---min-ratio (0.6) and --max-ratio (2) of the reference's length. A device run
-travels further on a loaded machine: umockdev plays each report after its
-delay, so the program runs slower than real time and a held stick is held
-longer (hidapi legs measured 1.16-1.56x under a load average of 20). Less was
+--min-ratio (0.6) and --max-ratio (3) of the reference's length. A device run
+travels further on a loaded machine: umockdev sleeps before each report it
+plays, every sleep overshoots, so the program runs slower than real time and a
+held stick is held longer (hidapi legs at 250 Hz measured 1.16-2.16x under a
+load average of 16-20). Less was
 seen twice in about a dozen runs under that load, both 0.70x (1.07 m of 1.53,
 once evdev, once SDL2), not reproduced in three reruns and not explained.
 
@@ -50,7 +51,7 @@ def main():
     p.add_argument("--rate", type=int, default=240)
     p.add_argument("--max-angle", type=float, default=10.0)
     p.add_argument("--min-ratio", type=float, default=0.6)
-    p.add_argument("--max-ratio", type=float, default=2.0)
+    p.add_argument("--max-ratio", type=float, default=3.0)
     p.add_argument("--ref-legs", type=int, default=0, help="compare with only the reference's first N legs")
     a = p.parse_args()
     run = legs(positions(a.run), seconds_list(a.cuts), a.rate)
