@@ -68,13 +68,17 @@ proc = subprocess.Popen([bin, "run", "--fast", "--display", "headless", "--input
 status = re.compile(rb"^\[ *(\d+)\.\d s\] ", re.M)
 rss_1min = rss_end = None
 rss_end_at = 0
-next_edit, edits, seen = 300, 0, 0
+next_edit, edits, seen, applied = 300, 0, 0, 0
+pending = b""
 log = open("edits.log", "w")
 with open("run.out", "rb") as follow:
     while proc.poll() is None:
-        chunk = follow.read()
+        pending += follow.read()
+        cut = pending.rfind(b"\n") + 1  # whole lines only
+        chunk, pending = pending[:cut], pending[cut:]
         for m in status.finditer(chunk):
             seen = int(m.group(1))
+        applied += chunk.count(b"config: applied before tick")
         try:
             rss = int(re.search(r"VmRSS:\s*(\d+) kB", open(f"/proc/{proc.pid}/status").read()).group(1))
         except (OSError, AttributeError):
@@ -84,7 +88,10 @@ with open("run.out", "rb") as follow:
             if rss_1min is None and seen >= 60:
                 rss_1min = rss
             rss_end, rss_end_at = rss, seen
-        if seen >= next_edit and next_edit <= minutes * 60 - 180:
+        # One edit at a time: on a loaded machine this loop may wake after two
+        # marks have passed, and a second edit before the first is applied would
+        # undo it (the watcher reads the file once it is quiet).
+        if seen >= next_edit and next_edit <= minutes * 60 - 180 and applied == edits:
             edits += 1
             speed = "2.5" if edits % 2 else "3.0"
             open("tune.new", "w").write(f"[locomotion]\nmax_speed = {speed}\n")
