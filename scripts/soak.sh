@@ -91,7 +91,7 @@ with open("run.out", "rb") as follow:
         # One edit at a time: on a loaded machine this loop may wake after two
         # marks have passed, and a second edit before the first is applied would
         # undo it (the watcher reads the file once it is quiet).
-        if seen >= next_edit and next_edit <= minutes * 60 - 180 and applied == edits:
+        if seen >= next_edit and seen <= minutes * 60 - 180 and applied == edits:
             edits += 1
             speed = "2.5" if edits % 2 else "3.0"
             open("tune.new", "w").write(f"[locomotion]\nmax_speed = {speed}\n")
@@ -117,7 +117,12 @@ reconnects=$(grep -c 'controller connected: resuming' run.out)
 # The last minute's replug comes 28 s before the end, so every unplug is followed by one.
 [[ $reconnects -eq $minutes ]] || fail "$reconnects replugs logged, expected $minutes"
 applied=$(grep -c 'config: applied before tick' run.out)
-[[ $applied -eq $edits ]] || fail "$applied config edits applied, $edits made"
+# An edit is made only once the one before it is applied, so only the last can
+# be missing, when the simulation (up to 68 s ahead of the status line, running
+# hundreds of simulated seconds per wall second) finished before the watcher's
+# 100 ms of quiet were over: that is a race of the test, not of marionette.
+((edits >= 1 && (applied == edits || applied == edits - 1))) ||
+  fail "$applied config edits applied, $edits made (only the last may miss the end)"
 "$bin" replay soak.mlog --trace replay.csv >replay.out 2>&1 || fail "replay exited $?: $(tail -2 replay.out)"
 if cmp -s run.csv replay.csv; then same=yes; else same=no; fail "replay trace differs from the run's: $(cmp run.csv replay.csv | head -1)"; fi
 if [[ -z $rss_1min ]]; then
