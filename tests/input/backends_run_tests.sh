@@ -78,14 +78,15 @@ for spec in \
   python3 "$src/tests/input/check_walk.py" "$b.csv" ref.csv --ref-cuts 3.0 --ref-legs 1 | sed "s/^/$b plain: /"
 
   # Replug: leg 1 (2.5 s lead), unplugged at 7 s (umockdev 0.17 cannot wait for a
-  # script to end, and the leg may run late), the next node at 8 s, leg 2 1 s later.
+  # script to end, and the leg may run late), the next node at 8 s, leg 2 2 s later
+  # (SDL2 probes the new node and closes it before it opens it for good).
   firmware "$format" "$pad" leg1.prog "$b.leg1.script" 2500
-  firmware "$format" "$pad" leg2.prog "$b.leg2.script" 1000
+  firmware "$format" "$pad" leg2.prog "$b.leg2.script" 2000
   if [[ $backend == hidapi ]]; then cp "$data/dualsense_hidraw_replugged.umockdev" "$b.replugged.umockdev"
   else sed "$rename" "$data/$desc" >"$b.replugged.umockdev"; fi
   timeout 60 "$wrapper" "$replug" "$data/$desc" "$node" "$data/$ioctl" "$b.leg1.script" 7 \
     "$b.replugged.umockdev" "$node2" "$b.leg2.script" 8 -- \
-    "$bin" run --input "$backend" --duration 11.5 --display headless --record "$b.r.mlog" --trace "$b.r.csv" \
+    "$bin" run --input "$backend" --duration 13 --display headless --record "$b.r.mlog" --trace "$b.r.csv" \
     --stats-json "$b.r.json" >"$b.r.out" 2>"$b.r.err"
   rc=$?
   check "$b replug: run exits 0 (rc $rc: $(grep -v WARNING "$b.r.err" | grep -v '^$' | tail -2))" test $rc -eq 0
