@@ -210,8 +210,15 @@ void InputThread::run_sdl(InputRing& ring, std::promise<Outcome>& started) {
     InputRingWriter<InputRing> writer(ring);
     std::array<InputSample, 1> batch{};
     const FamilyCalibration& cal = options_.config.family(DeviceFamily::sdl);
+    std::uint64_t disconnects_seen = 0;
     while (!stopping()) {
         if (sdl.poll(batch, kSdlPollTimeoutMs) == 1) push_calibrated(writer, cal, batch[0]);
+        // A controller that went away is passed on to the simulation (the puppet
+        // idles until a sample comes again), as the other backends do.
+        if (sdl.disconnects() != disconnects_seen) {
+            disconnects_seen = sdl.disconnects();
+            writer.push_disconnect(monotonic_now_ns());
+        }
         connected_.store(sdl.connected(), std::memory_order_release);
         connects_.store(sdl.connects(), std::memory_order_relaxed);
         disconnects_.store(sdl.disconnects(), std::memory_order_relaxed);

@@ -56,9 +56,10 @@ done
 
 # The SDL2 GameController backend on the same test bed: SDL finds the pad through
 # libudev (which umockdev fakes too), reads its ids and opens it as a game
-# controller with its built-in mapping. (Its event delivery is not checked here:
-# SDL opens the node more than once, and umockdev-run's evemu replay did not
-# reliably reach the second open, so samples were lost by timing alone.)
+# controller with its built-in mapping. (Its event delivery is checked in
+# backends_run_tests.sh: SDL opens the node more than once, and what umockdev's
+# evemu replay sends before SDL's probe closes the node is lost, so there the
+# events wait until SDL has opened it for good.)
 timeout 20 umockdev-run -d "$data/dualsense.umockdev" -i "/dev/input/event9=$data/dualsense.ioctl" -- \
   "$bin" input monitor --backend sdl --raw --json --timeout 0.5 >sdl.json 2>sdl.err
 check "sdl: SDL2 opens the DualSense as a game controller ($(grep -v WARNING sdl.err | grep -v '^$' | head -1))" \
