@@ -229,10 +229,17 @@ void simulation_thread(PipelineShared& sh, SimulationLoop& loop, std::uint64_t t
     std::int64_t last_wake = t0;
     std::int64_t window_tick_max = 0;
     std::uint64_t ticks = 0;
+    // A recording played live is consumed on its own schedule (tick k takes
+    // exactly sample k, stamped by tick), even after the catch-up cap skipped
+    // time; a live controller's samples are consumed by the clock.
+    auto consume_time = [&] {
+        return wait_for_input ? t0 + static_cast<std::int64_t>(ticks + 1) * tick_ns : sim_time + tick_ns;
+    };
     auto run_one = [&](std::int64_t now) {
+        const std::int64_t due = consume_time();
         sim_time += tick_ns;
         const std::int64_t start = virtual_time ? monotonic_ns() : now;
-        loop.run_tick(sim_time, virtual_time ? sim_time : start);
+        loop.run_tick(due, virtual_time ? sim_time : start);
         const std::int64_t took = monotonic_ns() - start;
         result.tick_time.add(took);
         if (took > window_tick_max) window_tick_max = took;
@@ -263,7 +270,7 @@ void simulation_thread(PipelineShared& sh, SimulationLoop& loop, std::uint64_t t
         }
         if (due > result.max_ticks_per_wake) result.max_ticks_per_wake = due;
         for (std::int32_t i = 0; i < due && ticks < total_ticks; ++i) {
-            while (wait_for_input && sh.input_watermark_ns.load(std::memory_order_acquire) < sim_time + tick_ns &&
+            while (wait_for_input && sh.input_watermark_ns.load(std::memory_order_acquire) < consume_time() &&
                    !sh.input_done.load(std::memory_order_acquire) && !sh.stop.load(std::memory_order_relaxed))
                 sleep_until_ns(monotonic_ns() + 100'000);  // a sleep, not a spin: the input thread may share our CPU
             run_one(monotonic_ns());

@@ -202,7 +202,8 @@ namespace {
 // "TICKS CONFIG_CHANGES UNREADABLE_BLOCKED" to FOLDER/result.txt.
 void act_out_config_faults(const std::string& folder) {
     const std::string file = folder + "/live.toml";
-    const std::string good = "[locomotion]\nmax_speed = 3.0\n";
+    // Not the default (3.0): a fault read as "no settings" would show as a change.
+    const std::string good = "[locomotion]\nmax_speed = 2.0\n";
     std::ofstream(file) << good;
     PipelineOptions o = realtime_run("hold 9s ly=1\n", 9 * 240);
     o.config = load_config(file).sim;
@@ -283,7 +284,7 @@ TEST_CASE("the watched config file deleted, made a folder, unreadable or cut sho
     CHECK(test::count_lines_with(errors, "config:") == 4);  // one line per fault, nothing else
     CHECK(config_changes == 1);
     CHECK(test::count_lines_with(printed, "config: applied before tick") == 1);
-    CHECK_THAT(printed, Catch::Contains("locomotion.max_speed 3.0 → 1.5"));
+    CHECK_THAT(printed, Catch::Contains("locomotion.max_speed 2.0 → 1.5"));
     WARN("config file faults, stderr:\n" << errors);
 }
 

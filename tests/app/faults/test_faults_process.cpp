@@ -82,6 +82,22 @@ TEST_CASE("run stopped (SIGSTOP) for 3 s and resumed, the catch-up cap holds, th
     Child replay({"replay", dir.path("run.mlog"), "--trace", dir.path("replay.csv")}, {}, dir.path("replay_err.txt"));
     REQUIRE(replay.finish(60.0) == 0);
     CHECK(test::read_file_or_empty(dir.path("replay.csv")) == test::read_file_or_empty(dir.path("run.csv")));
+
+    // The recording played live (--input log:) and stopped the same way still
+    // gives the replay's states: tick k consumes recorded sample k whatever the
+    // catch-up cap skipped.
+    Child live({"run", "--input", "log:" + dir.path("run.mlog"), "--trace", dir.path("live.csv"), "--stats-json",
+                dir.path("live.json")},
+               {}, dir.path("live_err.txt"));
+    REQUIRE(live.wait_for_line("[   1.0 s]", 30.0));
+    REQUIRE(::kill(live.pid(), SIGSTOP) == 0);
+    ::sleep(3);
+    REQUIRE(::kill(live.pid(), SIGCONT) == 0);
+    REQUIRE(live.finish(60.0) == 0);
+    const std::string live_stats = test::read_file_or_empty(dir.path("live.json"));
+    INFO(live_stats);
+    CHECK(test::json_number(live_stats, "catch_up_skipped_s") > 2.5);
+    CHECK(test::read_file_or_empty(dir.path("live.csv")) == test::read_file_or_empty(dir.path("replay.csv")));
 }
 
 TEST_CASE("run ignores the system clock, CLOCK_REALTIME jumping by hours changes nothing", "[faults][clock]") {
