@@ -129,7 +129,7 @@ TEST_CASE("run ignores the system clock, CLOCK_REALTIME jumping by hours changes
     WARN("clock jump: the run under the shim made " << shim_report.substr(0, shim_report.find('\n'))
                                                 << " (each one shifted by hours)");
     CHECK(test::json_number(stats, "ticks") == 3 * 240);
-    CHECK(test::json_number(stats, "catch_up_skipped_s") < 0.2);
+    CHECK(test::json_number(stats, "catch_up_skipped_s") < 0.25);
     CHECK(test::json_number(stats, "wall_s") > 2.9);
     CHECK(test::json_number(stats, "wall_s") < 4.5);
 }
