@@ -62,10 +62,17 @@ int count_lines_with(const std::string& text, const std::string& needle) {
 }
 
 std::int64_t resident_bytes() {
-    std::ifstream statm("/proc/self/statm");
-    std::int64_t size = 0, resident = 0;
-    statm >> size >> resident;
-    return resident * static_cast<std::int64_t>(::sysconf(_SC_PAGESIZE));
+    // Plain read(2) into a stack buffer: measuring must not allocate.
+    char buf[128] = {};
+    const int fd = ::open("/proc/self/statm", O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return 0;
+    const ssize_t n = ::read(fd, buf, sizeof buf - 1);
+    ::close(fd);
+    if (n <= 0) return 0;
+    char* end = nullptr;
+    (void)std::strtoll(buf, &end, 10);  // total size
+    const long long resident = std::strtoll(end, nullptr, 10);
+    return static_cast<std::int64_t>(resident) * static_cast<std::int64_t>(::sysconf(_SC_PAGESIZE));
 }
 
 void write_file(const std::string& path, const std::string& text) {
