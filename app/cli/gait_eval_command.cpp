@@ -82,8 +82,8 @@ int gait_sweep_command(const GaitEvalOptions& o) {
     if (o.json) fmt::print("{}", sweep_json(s));
     else print_sweep_text(s);
     if (o.check && s.passed != s.cases) {
-        fmt::print(stderr, "gait-eval --sweep {} --seed {}: {} of {} cases broke a limit\n", o.sweep, o.seed, s.cases - s.passed,
-                   s.cases);
+        log_message(LogLevel::error, fmt::format("gait-eval --sweep {} --seed {}: {} of {} cases broke a limit", o.sweep,
+                                                 o.seed, s.cases - s.passed, s.cases));
         return 1;
     }
     return 0;

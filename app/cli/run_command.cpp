@@ -73,6 +73,7 @@ void write_stats_json(const std::string& path, const RunOptions& o, const SimCon
         "\"stopped\":{},\"shutdown_ms\":{},\"final_hash\":\"{:016x}\","
         "\"tick_time_us\":{},\"frame_time_us\":{},\"input_to_tick_latency_us\":{},{},"
         "\"samples\":{},\"dropped_samples\":{},\"frames\":{},\"missed_frames\":{},\"catch_up_drops\":{},"
+        "\"catch_up_skipped_s\":{},\"max_ticks_per_wake\":{},"
         "\"records_dropped\":{},\"config_changes\":{},\"disconnects\":{},\"reconnects\":{},"
         "\"distance_m\":{},\"top_speed_m_s\":{},\"realtime_warning\":{}}}\n",
         json::quote(o.input), json::quote(r.display_description.empty() ? "headless" : r.display_description),
@@ -80,7 +81,8 @@ void write_stats_json(const std::string& path, const RunOptions& o, const SimCon
         json::number(r.wall_s), r.stopped ? "true" : "false", json::number(r.shutdown_ms), r.final_hash,
         histogram_json(r.tick_time), histogram_json(r.frame_time), histogram_json(r.input_latency),
         present_latency_json(r), r.samples_pushed,
-        r.samples_dropped, r.frames, r.missed_frames, r.catch_up_drops, r.records_dropped, r.config_changes,
+        r.samples_dropped, r.frames, r.missed_frames, r.catch_up_drops, json::number(r.catch_up_skipped_s),
+        r.max_ticks_per_wake, r.records_dropped, r.config_changes,
         r.disconnects, r.reconnects, json::number(r.distance_m), json::number(r.top_speed),
         r.realtime_warning.empty() ? "null" : json::quote(r.realtime_warning));
     write_text_file(path, text);

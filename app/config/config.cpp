@@ -1,6 +1,10 @@
 #include "app/config/config.hpp"
 
+#include <sys/stat.h>
 #include <toml++/toml.h>
+#include <cerrno>
+#include <cstring>
+#include <iterator>
 
 #include <charconv>
 #include <cmath>
@@ -303,11 +307,17 @@ std::string toml_string(const std::string& s) {
 }
 
 std::string read_file(const std::string& path) {
+    // A directory opens as a stream and reads as empty, which would silently
+    // mean "all defaults": refuse it by name.
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0)
+        throw ConfigError(path, 0, "", std::string("cannot open the configuration file: ") + std::strerror(errno));
+    if (S_ISDIR(st.st_mode)) throw ConfigError(path, 0, "", "is a directory, not a configuration file");
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw ConfigError(path, 0, "", "cannot open the configuration file");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
+    if (!in) throw ConfigError(path, 0, "", std::string("cannot open the configuration file: ") + std::strerror(errno));
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) throw ConfigError(path, 0, "", std::string("cannot read the configuration file: ") + std::strerror(errno));
+    return text;
 }
 
 // ---- [motion_graph.buttons] (docs/config.md): button name → graph label -------

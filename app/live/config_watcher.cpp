@@ -15,7 +15,7 @@ ConfigWatcher::ConfigWatcher(const std::string& path) : path_(path) {
     name_ = slash == std::string::npos ? path : path.substr(slash + 1);
     fd_ = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
     if (fd_ < 0) throw std::runtime_error(path + ": cannot watch for live tuning: inotify: " + std::strerror(errno));
-    if (inotify_add_watch(fd_, folder.c_str(), IN_CLOSE_WRITE | IN_MOVED_TO | IN_CREATE | IN_MODIFY) < 0) {
+    if (inotify_add_watch(fd_, folder.c_str(), IN_CLOSE_WRITE | IN_MOVED_TO | IN_CREATE | IN_MODIFY | IN_DELETE | IN_MOVED_FROM | IN_ATTRIB) < 0) {
         const int err = errno;
         ::close(fd_);
         throw std::runtime_error(path + ": cannot watch " + folder + " for live tuning: " + std::strerror(err));

@@ -2,6 +2,8 @@
 // Watches one configuration file with inotify for live tuning. It watches the
 // file's folder, not the file, because editors usually save by writing a new
 // file and renaming it over the old one (which would end a watch on the file).
+// Deleting, renaming away and changing the permissions of the file count as
+// edits too, so the reader can say once that it cannot be read any more.
 #include <string>
 
 namespace marionette {

@@ -260,6 +260,8 @@ void input_thread(PipelineShared& sh, const InputScript& script, std::int64_t t0
 struct SimulationThreadResult {
     TickTimeHistogram tick_time;
     std::uint64_t catch_up_drops = 0;
+    std::int64_t skipped_ns = 0;           // time skipped by the catch-up cap
+    std::int32_t max_ticks_per_wake = 0;   // the longest burst of ticks run for one wake-up
 };
 
 // `wait_for_input`: every sample up to a tick's time must be in the ring before
@@ -276,10 +278,17 @@ void simulation_thread(PipelineShared& sh, SimulationLoop& loop, std::uint64_t t
     std::int64_t last_wake = t0;
     std::int64_t window_tick_max = 0;
     std::uint64_t ticks = 0;
+    // A recording played live is consumed on its own schedule (tick k takes
+    // exactly sample k, stamped by tick), even after the catch-up cap skipped
+    // time; a live controller's samples are consumed by the clock.
+    auto consume_time = [&] {
+        return wait_for_input ? t0 + static_cast<std::int64_t>(ticks + 1) * tick_ns : sim_time + tick_ns;
+    };
     auto run_one = [&](std::int64_t now) {
+        const std::int64_t due = consume_time();
         sim_time += tick_ns;
         const std::int64_t start = virtual_time ? monotonic_ns() : now;
-        loop.run_tick(sim_time, virtual_time ? sim_time : start);
+        loop.run_tick(due, virtual_time ? sim_time : start);
         const std::int64_t took = monotonic_ns() - start;
         result.tick_time.add(took);
         if (took > window_tick_max) window_tick_max = took;
@@ -311,14 +320,16 @@ void simulation_thread(PipelineShared& sh, SimulationLoop& loop, std::uint64_t t
             sim_time += driver.dropped_ns - dropped_before;
             sh.counters.catch_up_drops.store(driver.catch_up_cap_hits, std::memory_order_relaxed);
         }
+        if (due > result.max_ticks_per_wake) result.max_ticks_per_wake = due;
         for (std::int32_t i = 0; i < due && ticks < total_ticks; ++i) {
-            while (wait_for_input && sh.input_watermark_ns.load(std::memory_order_acquire) < sim_time + tick_ns &&
+            while (wait_for_input && sh.input_watermark_ns.load(std::memory_order_acquire) < consume_time() &&
                    !sh.input_done.load(std::memory_order_acquire) && !sh.stop.load(std::memory_order_relaxed))
                 sleep_until_ns(monotonic_ns() + 100'000);  // a sleep, not a spin: the input thread may share our CPU
             run_one(monotonic_ns());
         }
     }
     result.catch_up_drops = driver.catch_up_cap_hits;
+    result.skipped_ns = driver.dropped_ns;
     sh.simulation_done.store(true, std::memory_order_release);
 }
 
@@ -339,6 +350,8 @@ struct RenderInputs {
     float ankle_height = 0.08f;
     int tick_rate_hz = 240;
     Interpolation interpolation = Interpolation::interpolate;
+    std::uint64_t stall_after_frames = 0;  // test hook: PipelineOptions::test_render_stall_ns
+    std::int64_t stall_ns = 0;
 };
 
 // Each frame is stamped when presented: the page flip's vblank time on KMS, after
@@ -407,6 +420,7 @@ void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, Ren
             }
             presented_at = r.present_ns;
         }
+        if (in.stall_ns > 0 && count == in.stall_after_frames) sleep_until_ns(monotonic_ns() + in.stall_ns);
         const std::int64_t end = monotonic_ns();
         frames.presented(virtual_time ? at : (presented_at > 0 ? presented_at : end));
         frame_time.add(end - start);
@@ -516,8 +530,13 @@ struct LiveTuning {
         AppConfig next;
         try {
             next = load_config(watcher->path());
-        } catch (const ConfigError& e) {
+        } catch (const ParseError& e) {
+            // Missing, a directory, unreadable, half-written, invalid (or a terrain
+            // file it names is): the run carries on with what it has.
             log_message(LogLevel::warning, fmt::format("config: {}; keeping the previous configuration", e.what()), err);
+            return;
+        } catch (const std::exception& e) {
+            log_message(LogLevel::warning, fmt::format("config: {}: {}; keeping the previous configuration", watcher->path(), e.what()), err);
             return;
         }
         Outcome kept = structure_unchanged(published, next.sim);
@@ -742,8 +761,8 @@ public:
         notifier_.stopping();
         sh_.stop.store(true);
         if (o_.device) {
-            publish_device_counters();
             device_->stop();
+            publish_device_counters();  // its final counts, now that it has stopped
         }
         for (std::thread* t : guard_.threads)
             if (t->joinable()) t->join();
@@ -775,15 +794,18 @@ private:
     void start_threads() {
         // The render thread first: the display must open before the clock starts.
         start_display();
-        wall_start_ = monotonic_ns();
-        const std::int64_t t0 = o_.virtual_time ? 0 : wall_start_ + kThreadStartLeadNs;
         // The input thread before the simulation thread: a device backend that
         // cannot open its pad fails here, before any tick runs or is recorded.
+        // The clock starts once it is open: a pad's start-up dialogue (up to
+        // 200 ms for a Switch Pro's calibration) must not count as a late tick.
         if (o_.device) {
             if (const Outcome started = device_->start(sh_.input_ring, *o_.device); !started.ok())
                 throw ImportError("--input " + o_.device->backend, 0, started.problem());
             result_.input_description = device_->backend_description();
-        } else {
+        }
+        wall_start_ = monotonic_ns();
+        const std::int64_t t0 = o_.virtual_time ? 0 : wall_start_ + kThreadStartLeadNs;
+        if (!o_.device) {
             in_thread_ = std::thread(input_thread, std::ref(sh_), std::cref(o_.script), t0, o_.virtual_time);
         }
         sim_thread_ = std::thread(simulation_thread, std::ref(sh_), std::ref(*loop_), o_.total_ticks, t0,
@@ -793,8 +815,10 @@ private:
 
     void start_display() {
         const Simulation& sim = loop_->simulation();
-        const RenderInputs inputs{&o_.display, &sim.skeleton(), &sim.terrain(), o_.config.ankle_height,
-                                  o_.config.tick_rate_hz, o_.interpolation};
+        const RenderInputs inputs{&o_.display,       &sim.skeleton(),
+                                  &sim.terrain(),    o_.config.ankle_height,
+                                  o_.config.tick_rate_hz, o_.interpolation,
+                                  o_.test_render_stall_after_frames, o_.test_render_stall_ns};
         gfx_thread_ = std::thread(render_thread, std::ref(sh_), o_.frame_rate_hz, o_.virtual_time, inputs,
                                   std::ref(display_), std::ref(result_.frame_time), std::ref(result_.present_latency));
         while (display_.state.load(std::memory_order_acquire) == DisplayThreadState::opening)
@@ -854,6 +878,8 @@ private:
         r.frames = sh_.counters.frames.load();
         r.missed_frames = sh_.counters.missed_frames.load();
         r.catch_up_drops = sim_result_.catch_up_drops;
+        r.catch_up_skipped_s = static_cast<double>(sim_result_.skipped_ns) / 1e9;
+        r.max_ticks_per_wake = sim_result_.max_ticks_per_wake;
         r.records_dropped = sh_.counters.records_dropped.load();
         r.config_changes = loop_->config_changes();
         r.disconnects = loop_->assembler().disconnects();

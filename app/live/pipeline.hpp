@@ -284,6 +284,11 @@ struct PipelineOptions {
     // Set (by a signal handler) to ask for a clean stop; the time it was set, if known.
     const std::atomic<bool>* stop_request = nullptr;
     const std::atomic<std::int64_t>* stop_request_time_ns = nullptr;
+    // Test hook (fault injection, tests/app/test_faults.cpp): once this many frames
+    // have been built, the render thread stalls for test_render_stall_ns inside
+    // the next frame, as a blocked GPU driver would. 0 ns: off.
+    std::uint64_t test_render_stall_after_frames = 0;
+    std::int64_t test_render_stall_ns = 0;
 };
 
 struct PipelineResult {
@@ -305,6 +310,8 @@ struct PipelineResult {
     std::uint64_t frames = 0;
     std::uint64_t missed_frames = 0;
     std::uint64_t catch_up_drops = 0;
+    double catch_up_skipped_s = 0.0;    // simulated time skipped by those drops
+    std::int32_t max_ticks_per_wake = 0;  // most ticks run for one wake-up (≤ max_catch_up_ticks)
     std::uint64_t records_dropped = 0;  // > 0: the log and trace are incomplete
     std::uint64_t config_changes = 0;
     std::uint64_t disconnects = 0;
