@@ -461,6 +461,7 @@ constexpr float kMinSwingPhaseShare = 1e-3f;       // least (1 − lift phase) a
 constexpr float kReaimSpeedChange = 0.25f;         // m/s: a commanded speed change this large re-aims a swing
 constexpr double kReaimHeadingChangeRad = 0.25;    // rad: a stick direction change this large re-aims a swing
 constexpr float kLatestReaimProgress = 0.6f;       // a swing further along keeps its target
+constexpr float kStanceReachM = 0.42f;             // m: the root keeps each planted foot this close to its hip, horizontally
 constexpr std::int32_t kMaxReaims = 3;             // a swing re-aims at most this often (the stick turning on)
 constexpr float kMinReaimShiftM = 0.06f;           // m: a new target closer than this to the old one is not taken
 constexpr float kStopStaggerM = 0.05f;             // m: feet further apart along the heading close up when stopping
@@ -494,6 +495,40 @@ StickCommand read_stick(const GaitTickInput& in, const GaitConfig& c, float head
         cmd.dir_z = -in.stick_y / length;
     }
     return cmd;
+}
+
+// The planted feet's horizontal distances from their hips (−1: swinging).
+struct StanceReach {
+    float distance[2] = {-1.0f, -1.0f};
+};
+StanceReach stance_reach(const GaitState& g, vec3 root, float heading, const GaitRig& rig) {
+    StanceReach r;
+    const HeadingFrame h = heading_frame(heading);
+    for (int i = 0; i < 2; ++i) {
+        const FootState& f = g.feet[static_cast<std::size_t>(i)];
+        if (!f.swinging) r.distance[i] = horizontal_distance(root + h.left * (side_sign(i) * rig.hip_half_width), f.ankle);
+    }
+    return r;
+}
+
+// The root pivots on the planted feet: it never takes a hip further than
+// kStanceReachM (or, if it already was, than it was before this tick) from its
+// planted foot, so a stick that turned after a foot was planted swings the body
+// round that foot instead of dragging the leg out of reach.
+void keep_stance_in_reach(const GaitState& g, vec3& root, const HeadingFrame& h, const GaitRig& rig, const StanceReach& before) {
+    for (int pass = 0; pass < 2; ++pass)
+        for (int i = 0; i < 2; ++i) {
+            const FootState& f = g.feet[static_cast<std::size_t>(i)];
+            if (f.swinging || before.distance[i] < 0.0f) continue;
+            const vec3 hip = root + h.left * (side_sign(i) * rig.hip_half_width);
+            const float dx = hip.x - f.ankle.x, dz = hip.z - f.ankle.z;
+            const float d = std::sqrt(dx * dx + dz * dz);
+            const float limit = maxf(kStanceReachM, before.distance[i]);
+            if (d <= limit) continue;
+            const float back = 1.0f - limit / d;
+            root.x -= dx * back;
+            root.z -= dz * back;
+        }
 }
 
 // What steering decided this tick.
@@ -774,8 +809,10 @@ void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const
     const float dt = in.dt;
     const StickCommand cmd = read_stick(in, c, heading);
     const NearbyWalls walls = cmd.moving ? find_nearby_walls(terrain, c, root) : NearbyWalls{};
+    const StanceReach reach = stance_reach(g, root, heading, rig);
     const Steering s = steer(g, heading, root, cmd, walls, c, terrain, dt);
     const HeadingFrame h = heading_frame(heading);
+    keep_stance_in_reach(g, root, h, rig, reach);
     velocity = vec2(h.forward.x * g.speed, h.forward.z * g.speed);
     const double abs_diff = s.result.diff < 0 ? -s.result.diff : s.result.diff;
     const bool wants_steps = cmd.moving && (g.speed > 0.0f || g.turning_in_place || abs_diff > kStepTurnRad);
