@@ -158,8 +158,14 @@ float foot_phase(float cycle_phase, int foot) { return frac(cycle_phase - (foot 
 // time, so the toes point where the swing path's clearance floor looked for
 // them (build_swing_path); s already eases in and out over the swing (the
 // prototype's progress has zero tangents at both ends), so no further easing.
+// The toes keep their lift-off direction for the first kHoldRotationShare of
+// the step and reach their landing direction kHoldRotationShare before its end,
+// so a foot planted beside a riser lifts before its toes sweep toward it (the
+// path's clearance floor starts at its second key).
+constexpr float kHoldRotationShare = 0.1f;
 quat swing_rotation(const FootState& f, float s) {
-    return quat_slerp(f.start_rotation, f.target_rotation, s);
+    const float turn = clampf((s - kHoldRotationShare) / (1.0f - 2.0f * kHoldRotationShare), 0.0f, 1.0f);
+    return quat_slerp(f.start_rotation, f.target_rotation, turn);
 }
 
 // The swing path's Hermite keys from its heights: key i at s = i / (n − 1),
@@ -333,6 +339,10 @@ struct PathPrediction {
 };
 
 constexpr int kMaxPredictedTicks = 1200;
+constexpr float kMaxTurnPerStepDeg = 90.0f;  // most a foot turns in one swing
+constexpr float kMaxFootTurnDegS = 300.0f;   // … and on average per second of the swing
+// Radians a foot may turn in a swing landing in `seconds`.
+double max_foot_turn(float seconds) { return minf(kMaxTurnPerStepDeg, kMaxFootTurnDegS * seconds) * det::kDegToRad; }
 
 // Runs the tick's own steering law (steer_root: turns, braking, walls) and step
 // clock forward tick by tick from this tick's root until the foot's phase
@@ -371,12 +381,17 @@ Placement plan_target(const GaitState& g, const GaitTick& t, int foot, vec3 root
     vec3 under(p.mid_stance.x, 0.0f, p.mid_stance.z);
     if (g.first_step) under = 0.5f * (under + vec3(p.landing.x, 0.0f, p.landing.z));
     const vec3 spot = under + then.left * (side_sign(foot) * t.rig.hip_half_width);
-    return place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, then.forward);
+    // The foot turns at most kMaxTurnPerStepDeg in one swing, and no faster than
+    // kMaxFootTurnDegS on average (a sharp turn takes more steps to face round).
+    const vec3 toes = quat_rotate(g.feet[static_cast<std::size_t>(foot)].rotation, vec3(0.0f, 0.0f, 1.0f));
+    const double yaw = det::atan2(toes.x, toes.z);
+    const double facing = yaw + clamp_magnitude(det::wrap_angle(static_cast<double>(p.mid_stance.heading) - yaw),
+                                                max_foot_turn(p.time));
+    return place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, heading_frame(facing).forward);
 }
 
 constexpr float kShortestSwing = 0.12f;           // s: a late lift-off still swings this long
 constexpr float kWristDrag = 0.4f;                // hand tilt against its path's velocity, per m/cycle
-constexpr float kMaxTurnPerStepDeg = 90.0f;       // turning in place: most a foot turns in one swing
 constexpr float kMaxPelvisVerticalSpeed = 0.9f;   // m/s the pelvis follows its height target at, at most
 
 // Standing spot for a foot beside the other (planted) foot.
@@ -614,7 +629,7 @@ Placement aim_swing(const GaitState& g, const GaitTick& t, vec3 root, int i, flo
     const float time_to_land = predict_path(g, t, root, 1.0f - psi).time;
     const double turn = det::wrap_angle(static_cast<double>(t.desired_heading) - t.heading);
     // Small steps: a foot turns at most kMaxTurnPerStepDeg per swing.
-    const double max_turn = minf(t.c.turn_rate_deg_s * time_to_land, kMaxTurnPerStepDeg) * det::kDegToRad;
+    const double max_turn = minf(minf(t.c.turn_rate_deg_s, kMaxFootTurnDegS) * time_to_land, kMaxTurnPerStepDeg) * det::kDegToRad;
     const HeadingFrame then = heading_frame(t.heading + clamp_magnitude(turn, max_turn));
     const vec3 spot = root + then.left * (side_sign(i) * t.rig.hip_half_width);
     return place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, then.forward);

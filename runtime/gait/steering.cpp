@@ -15,7 +15,6 @@ constexpr float kMinBrakeM_s2 = 8.0f;              // braking is at least this h
 constexpr double kFreeTurnDeg = 30.0;              // a turn this small keeps the commanded speed
 constexpr double kPivotTurnDeg = 90.0;             // … from here on the speed is at most the pivot speed
 constexpr double kEndTurnInPlaceDeg = 20.0;        // a turn in place ends once the aim is this close to the heading
-constexpr float kTurnInPlaceEntrySpeedM_s = 0.3f;  // a wide reversal turns in place once braked to this speed
 constexpr float kMinSlideShare = 0.25f;            // a clipped goal slower than this share of the stick's: stand
 constexpr float kWallProbeHorizonS = 0.8f;         // s of travel at max_speed the wall search looks ahead
 constexpr float kNoWallM = 1e9f;
@@ -140,7 +139,8 @@ SteerResult steer_root(RootMotion& m, const SteerGoal& goal, const NearbyWalls& 
     }
     r.diff = det::wrap_angle(static_cast<double>(r.heading) - m.heading);
     const double abs_diff = r.diff < 0 ? -r.diff : r.diff;
-    if (abs_diff > c.turn_in_place_deg * det::kDegToRad && m.speed <= kTurnInPlaceEntrySpeedM_s) m.turning_in_place = 1;
+    // A wide reversal turns in place at once from a walk, and from a run once braked to walking speed.
+    if (abs_diff > c.turn_in_place_deg * det::kDegToRad && m.speed <= c.run_threshold) m.turning_in_place = 1;
     else if (abs_diff < kEndTurnInPlaceDeg * det::kDegToRad) m.turning_in_place = 0;
     // The heading: at the turn rate, and no faster than the lateral acceleration allows at this speed.
     const double turn_rate = c.turn_rate_deg_s * det::kDegToRad;
