@@ -120,6 +120,12 @@ Placement place_foot(const Terrain& terrain, const GaitRig& rig, float x, float 
         const vec3 p = ankle + quat_rotate(rotation, vec3(0.0f, -rig.ankle_height, ahead)) + vec3(0.0f, lift, 0.0f);
         misfit = maxf(misfit, query_ground(terrain, p.x, p.z).height - p.y - 0.02f);
     }
+    // Right at the tip the toes sweep forward before the foot has risen: no
+    // ground there may stand above the sole's plane at all.
+    for (float ahead : {tip + 0.01f, tip + 0.03f}) {
+        const vec3 p = ankle + quat_rotate(rotation, vec3(0.0f, -rig.ankle_height, ahead)) + vec3(0.0f, lift, 0.0f);
+        misfit = maxf(misfit, query_ground(terrain, p.x, p.z).height - p.y);
+    }
     // Nor may the heel hang against a riser behind it: the swing comes down past
     // an edge one path key (a few cm) before it lands, so ground behind the
     // ankle rising above the sole would be clipped on the way down.
