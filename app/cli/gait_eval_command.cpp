@@ -89,6 +89,17 @@ int gait_sweep_command(const GaitEvalOptions& o) {
     return 0;
 }
 
+// A turn time in the JSON: seconds, or null when there was no turn or one never got there.
+std::string turn_time_json(double seconds, bool any) { return any && seconds >= 0.0 ? json::number(seconds) : "null"; }
+
+std::string turns_json(const GaitMetrics& m) {
+    std::string out = "[";
+    for (const TurnTime& t : m.turns)
+        out += fmt::format("{}{{\"tick\":{},\"angle_deg\":{},\"time_s\":{},\"after_stick_s\":{}}}", out.size() > 1 ? "," : "", t.tick,
+                           json::number(t.angle_deg), turn_time_json(t.time_s, true), turn_time_json(t.after_stick_s, true));
+    return out + "]";
+}
+
 int gait_eval_command(const GaitEvalOptions& o) {
     if (o.sweep != -1) return gait_sweep_command(o);
     if (!o.out_dir.empty()) throw ImportError("--out", 0, "only with --sweep (where failing cases are written)");
@@ -112,11 +123,13 @@ int gait_eval_command(const GaitEvalOptions& o) {
     if (o.json) {
         fmt::print("{{\"terrain\":{},\"program\":{},\"motion_source\":{},\"graph\":{},\"ticks\":{},\"foot_skate_mm\":{},"
                    "\"penetration_mm\":{},\"speed_error_pct\":{},\"speed_expectation\":{},\"speed_windows\":{},"
-                   "\"max_joint_speed_deg_s\":{},\"steps\":{},\"flight_phases\":{},\"final_hash\":\"{:016x}\",\"limits_ok\":{}}}\n",
+                   "\"max_joint_speed_deg_s\":{},\"obstacle_penetration_mm\":{},\"turn_time_s\":{},\"turns\":{},"
+                   "\"steps\":{},\"flight_phases\":{},\"final_hash\":\"{:016x}\",\"limits_ok\":{}}}\n",
                    json::quote(config.terrain_name), json::quote(o.program), json::quote(m.motion_source),
                    with_graph ? json::quote(graph_name) : std::string("null"), m.ticks, json::number(m.foot_skate_mm),
                    json::number(m.penetration_mm), json::number(m.speed_error_pct), json::quote(m.speed_expectation),
-                   m.speed_windows, json::number(m.max_joint_speed_deg_s), m.steps, m.flight_phases, m.final_hash,
+                   m.speed_windows, json::number(m.max_joint_speed_deg_s), json::number(m.obstacle_penetration_mm),
+                   turn_time_json(m.turn_time_s, !m.turns.empty()), turns_json(m), m.steps, m.flight_phases, m.final_hash,
                    with_graph ? "null" : checked.ok() ? "true" : "false");
     } else {
         fmt::print("gait-eval: {} on {} ({} ticks, motion from {})\n", o.program, config.terrain_name, m.ticks,
@@ -129,6 +142,12 @@ int gait_eval_command(const GaitEvalOptions& o) {
                    kMaxSpeedErrorPct, m.speed_windows);
         fmt::print("  max_joint_speed_deg_s  {:10.1f}  (limit < {}; {} at tick {})\n", m.max_joint_speed_deg_s, kMaxJointSpeedDegS,
                    m.fastest_joint, m.fastest_joint_tick);
+        fmt::print("  obstacle_penetration_mm {:9.4f}  (limit < {}; deepest: {} at tick {})\n", m.obstacle_penetration_mm,
+                   kMaxObstaclePenetrationMm, m.obstacle_point.empty() ? "none" : m.obstacle_point, m.obstacle_tick);
+        for (const TurnTime& t : m.turns)
+            fmt::print("  turn at tick {:5} of {:5.1f} deg: heading within {} deg after {} s ({} s after the stick settled)\n", t.tick,
+                       t.angle_deg, kTurnToleranceDeg, t.time_s < 0.0 ? std::string("never") : fmt::format("{:.3f}", t.time_s),
+                       t.after_stick_s < 0.0 ? std::string("-") : fmt::format("{:.3f}", t.after_stick_s));
         fmt::print("  steps {}  flight_phases {}  final hash {:016x}\n", m.steps, m.flight_phases, m.final_hash);
         if (!checked.ok()) fmt::print("  {}: {}\n", with_graph ? "NOT FINITE" : "LIMITS BROKEN", checked.problem());
     }

@@ -138,6 +138,7 @@ const KeySpec kKeys[] = {
     {"gait", "slope_speed_factor", &SimConfig::slope_speed_factor, 0.0, 0.05, "speed reduction per degree of slope"},
     {"gait", "turn_in_place_deg", &SimConfig::turn_in_place_deg, 30.0, 180.0, "reversals wider than this turn in place (°)"},
     {"gait", "stop_transition_s", &SimConfig::stop_transition_s, 0.05, 1.0, "longest time the swing foot takes to plant after a stop (s)"},
+    {"gait", "max_step_height", &SimConfig::max_step_height, 0.05, 1.0, "a box rising more than this above the ground beside it is an obstacle the puppet stops at (m)"},
     {"gait", "breath_amplitude", &SimConfig::breath_amplitude, 0.0, 0.05, "pelvis rise of a breath when idle (m)"},
     {"gait", "breath_period_s", &SimConfig::breath_period_s, 0.5, 20.0, "length of one breath (s)"},
 };

@@ -10,6 +10,7 @@
 #include "app/graph/graph_files.hpp"
 #include "runtime/gait/gait.hpp"
 #include "runtime/gait/puppet.hpp"
+#include "runtime/ground/obstacles.hpp"
 #include "runtime/sim/simulation.hpp"
 
 namespace marionette {
@@ -129,6 +130,43 @@ std::vector<Hold> moving_holds(const StickProgram& program, const SimConfig& c) 
     return holds;
 }
 
+// A hold of the program (stick constant) and when the stick's change toward it
+// began: the first tick after the previous hold (so a ramp or circle into it
+// counts as the change), or the hold's own first tick.
+struct StickTurn {
+    std::uint64_t start_tick;
+    std::uint64_t settle_tick;
+    std::uint64_t end_tick;  // exclusive
+    double direction;        // the stick's heading during the hold, radians
+};
+
+std::vector<StickTurn> stick_turns(const StickProgram& program, const SimConfig& c, const std::vector<TickInput>& ticks) {
+    std::vector<StickTurn> turns;
+    double t = 0.0, change_start = 0.0;
+    bool after_hold = true;
+    for (const StickSegment& seg : program.segments) {
+        const double start = t;
+        t += seg.duration_s;
+        if (seg.kind == StickSegment::Kind::press) continue;  // buttons: the stick holds
+        if (seg.kind != StickSegment::Kind::hold) {
+            if (after_hold) change_start = start;
+            after_hold = false;
+            continue;
+        }
+        const std::uint64_t first = static_cast<std::uint64_t>(std::llround(start * c.tick_rate_hz));
+        const std::uint64_t end = std::min<std::uint64_t>(ticks.size(), static_cast<std::uint64_t>(std::llround(t * c.tick_rate_hz)));
+        const std::uint64_t begin = after_hold ? first : static_cast<std::uint64_t>(std::llround(change_start * c.tick_rate_hz));
+        after_hold = true;
+        if (first >= end) continue;
+        const double sx = ticks[first].left_x / static_cast<double>(kStickScale);
+        const double sy = ticks[first].left_y / static_cast<double>(kStickScale);
+        const double deflection = std::sqrt(sx * sx + sy * sy);
+        if (stick_speed_fraction(static_cast<float>(deflection > 1.0 ? 1.0 : deflection), c) <= 0.0f) continue;
+        turns.push_back({begin, first, end, det::atan2(sx, -sy)});
+    }
+    return turns;
+}
+
 }  // namespace
 
 bool foot_in_stance(const PuppetState& s, int foot) {
@@ -143,7 +181,8 @@ Outcome check_gait_metrics_finite(const GaitMetrics& m) {
     const std::pair<const char*, double> values[] = {{"foot_skate_mm", m.foot_skate_mm},
                                                      {"penetration_mm", m.penetration_mm},
                                                      {"speed_error_pct", m.speed_error_pct},
-                                                     {"max_joint_speed_deg_s", m.max_joint_speed_deg_s}};
+                                                     {"max_joint_speed_deg_s", m.max_joint_speed_deg_s},
+                                                     {"obstacle_penetration_mm", m.obstacle_penetration_mm}};
     for (const auto& [name, value] : values)
         if (!std::isfinite(value)) return Outcome::failure(fmt::format("{} is not a finite number ({})", name, value));
     return Outcome::success();
@@ -158,6 +197,7 @@ Outcome check_gait_limits(const GaitMetrics& m) {
     check("penetration_mm", m.penetration_mm, kMaxPenetrationMm);
     check("speed_error_pct", m.speed_error_pct, kMaxSpeedErrorPct);
     check("max_joint_speed_deg_s", m.max_joint_speed_deg_s, kMaxJointSpeedDegS);
+    check("obstacle_penetration_mm", m.obstacle_penetration_mm, kMaxObstaclePenetrationMm);
     return out.empty() ? Outcome::success() : Outcome::failure(out);
 }
 
@@ -199,9 +239,10 @@ MeasuredPuppet drive_with_graph(Simulation& sim, std::shared_ptr<const MotionGra
 class GaitMeter {
 public:
     GaitMeter(const SimConfig& config, const Simulation& sim, const MeasuredPuppet& puppet,
-              const std::vector<TickInput>& ticks, std::vector<Hold> holds, bool feet_csv, GaitMetrics& m)
+              const std::vector<TickInput>& ticks, std::vector<Hold> holds, std::vector<StickTurn> turns, bool feet_csv,
+              GaitMetrics& m)
         : config_(config), sim_(sim), terrain_(sim.terrain()), puppet_(puppet), ticks_(ticks), holds_(std::move(holds)),
-          m_(m), previous_(sim.state()), path_(holds_.size(), 0.0), expected_(holds_.size(), 0.0),
+          turns_(std::move(turns)), turn_index_(turns_.size(), -1), m_(m), previous_(sim.state()), path_(holds_.size(), 0.0), expected_(holds_.size(), 0.0),
           last_sample_(holds_.size()), sample_every_(static_cast<std::uint64_t>(config.tick_rate_hz / 4)) {
         for (int i = 0; i < 2; ++i)
             stance_anchor_[i] = sim.state().model_positions[static_cast<std::size_t>(puppet.feet[i].ankle)];
@@ -215,8 +256,16 @@ public:
         for (int i = 0; i < 2; ++i) measure_foot(i, s);
         count_flight_phase();
         measure_joint_speeds(s);
+        measure_obstacles(s);
         measure_hold_speeds(k, s);
+        measure_turns(k, s);
         previous_ = s;
+    }
+
+    // The slowest turn (one that never got there counts as slowest).
+    void finish_turns() {
+        for (const TurnTime& t : m_.turns)
+            if (t.time_s < 0.0 || (m_.turn_time_s >= 0.0 && t.time_s > m_.turn_time_s)) m_.turn_time_s = t.time_s;
     }
 
     // The worst speed error over the holds that ran to their end.
@@ -270,6 +319,46 @@ private:
             }
         }
         was_stance_[i] = stance;
+    }
+
+    // Obstacle penetration: every joint and every sole point against the boxes
+    // taller than max_step_height above the ground beside them.
+    void measure_obstacles(const PuppetState& s) {
+        auto deeper = [&](vec3 p) {
+            const double depth = obstacle_depth(terrain_, p, config_.max_step_height) * 1000.0;
+            if (!(depth > m_.obstacle_penetration_mm)) return false;
+            m_.obstacle_penetration_mm = depth;
+            m_.obstacle_tick = s.tick;
+            return true;
+        };
+        for (int j = 0; j < s.joint_count; ++j)
+            if (deeper(s.model_positions[static_cast<std::size_t>(j)])) m_.obstacle_point = sim_.skeleton().joint_names[static_cast<std::size_t>(j)];
+        for (int i = 0; i < 2; ++i) {
+            const FootPoints fp = foot_points(s, puppet_.feet[i], config_);
+            for (int p_index = 0; p_index < fp.count; ++p_index)
+                if (deeper(fp.points[p_index])) m_.obstacle_point = fmt::format("{} {}", i == 0 ? "left" : "right", fp.names[p_index]);
+        }
+    }
+
+    // Turn times: from each stick change's first tick until the heading is
+    // within kTurnToleranceDeg of the hold's direction.
+    void measure_turns(std::uint64_t k, const PuppetState& s) {
+        for (std::size_t i = 0; i < turns_.size(); ++i) {
+            const StickTurn& turn = turns_[i];
+            if (k == turn.start_tick) {
+                const double angle = std::fabs(det::wrap_angle(turn.direction - previous_.heading)) * det::kRadToDeg;
+                if (angle < kMinTurnDeg) continue;
+                turn_index_[i] = static_cast<int>(m_.turns.size());
+                m_.turns.push_back({turn.start_tick, angle, -1.0, -1.0});
+            }
+            if (turn_index_[i] < 0 || k < turn.start_tick || k >= turn.end_tick) continue;
+            TurnTime& t = m_.turns[static_cast<std::size_t>(turn_index_[i])];
+            if (t.time_s >= 0.0) continue;
+            if (std::fabs(det::wrap_angle(turn.direction - s.heading)) * det::kRadToDeg <= kTurnToleranceDeg) {
+                t.time_s = static_cast<double>(k + 1 - turn.start_tick) / config_.tick_rate_hz;
+                t.after_stick_s = k + 1 > turn.settle_tick ? static_cast<double>(k + 1 - turn.settle_tick) / config_.tick_rate_hz : 0.0;
+            }
+        }
     }
 
     void append_feet_csv_row(int i, const PuppetState& s, const FootPoints& fp, bool stance) {
@@ -339,6 +428,8 @@ private:
     const MeasuredPuppet& puppet_;
     const std::vector<TickInput>& ticks_;
     const std::vector<Hold> holds_;
+    const std::vector<StickTurn> turns_;
+    std::vector<int> turn_index_;  // per stick turn: its entry in m_.turns, −1: none (yet)
     GaitMetrics& m_;
     PuppetState previous_;
     bool airborne_[2] = {false, false};
@@ -371,12 +462,14 @@ GaitMetrics evaluate_gait(const SimConfig& config, const StickProgram& program, 
     MeasuredPuppet puppet;
     puppet.graph_full_speed_m_s = static_cast<double>(config.graph_full_stick_speed) * config.graph_leg_metres;
     if (graph) puppet = drive_with_graph(sim, std::move(graph), config, m);
-    GaitMeter meter(config, sim, puppet, ticks, std::move(holds), !feet_csv.empty(), m);
+    std::vector<StickTurn> turns = stick_turns(program, config, ticks);
+    GaitMeter meter(config, sim, puppet, ticks, std::move(holds), std::move(turns), !feet_csv.empty(), m);
     for (std::uint64_t k = 0; k < ticks.size(); ++k) {
         sim.step(ticks[k]);
         meter.measure_tick(k);
     }
     meter.finish_speed_error();
+    meter.finish_turns();
     if (!feet_csv.empty()) write_feet_csv(feet_csv, meter.feet_csv());
     m.ticks = ticks.size();
     m.final_hash = hash_state(sim.state());

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "runtime/errors/outcome.hpp"
 #include "runtime/graph/motion_graph.hpp"
@@ -15,6 +16,15 @@ namespace marionette {
 
 struct PuppetState;
 
+// One change of the stick's direction followed by a hold (docs/gait.md,
+// "Metrics"): how long the heading took to come within kTurnToleranceDeg of it.
+struct TurnTime {
+    std::uint64_t tick = 0;      // the stick's change began (the first tick after the previous hold)
+    double angle_deg = 0.0;      // the stick's direction − the heading then
+    double time_s = -1.0;        // from the change's start; < 0: not within the tolerance before the hold ended
+    double after_stick_s = -1.0; // from when the stick reached its direction (the hold's start)
+};
+
 struct GaitMetrics {
     // What drove the puppet: "gait" (the procedural gait) or "graph" (a motion graph).
     std::string motion_source = "gait";
@@ -24,6 +34,9 @@ struct GaitMetrics {
     double penetration_mm = 0.0;         // deepest sole or toe point below the surface
     double speed_error_pct = 0.0;        // worst steady-state speed error over the program's holds
     double max_joint_speed_deg_s = 0.0;  // largest angular speed of any joint's local rotation
+    double obstacle_penetration_mm = 0.0;  // deepest joint or sole point inside an obstacle box
+    std::vector<TurnTime> turns;         // every stick direction change of at least kMinTurnDeg
+    double turn_time_s = 0.0;            // the slowest of them (time_s; < 0 when one never got there)
     int steps = 0;                       // touchdowns seen in the sole heights
     int flight_phases = 0;               // intervals with both feet off the ground
     int speed_windows = 0;               // holds long enough to measure the speed over
@@ -35,6 +48,8 @@ struct GaitMetrics {
     std::uint64_t deepest_tick = 0;
     std::string deepest_point;           // e.g. "foot_l toe tip (swing)"
     std::uint64_t skate_tick = 0;
+    std::string obstacle_point;          // e.g. "shin_l"
+    std::uint64_t obstacle_tick = 0;
 };
 
 // The limits (docs/gait.md).
@@ -42,6 +57,11 @@ inline constexpr double kMaxFootSkateMm = 0.5;
 inline constexpr double kMaxPenetrationMm = 1.0;
 inline constexpr double kMaxSpeedErrorPct = 2.0;
 inline constexpr double kMaxJointSpeedDegS = 1500.0;
+inline constexpr double kMaxObstaclePenetrationMm = 1.0;
+// Turn times: stick changes of at least kMinTurnDeg from the heading, done when
+// the heading is within kTurnToleranceDeg of the stick.
+inline constexpr double kMinTurnDeg = 20.0;
+inline constexpr double kTurnToleranceDeg = 10.0;
 
 // Ok when every limit holds, else which failed and by how much.
 Outcome check_gait_limits(const GaitMetrics& metrics);

@@ -115,6 +115,7 @@ inline constexpr SweepMetric kSweepMetrics[] = {
     {"penetration_mm", kMaxPenetrationMm, &GaitMetrics::penetration_mm},
     {"speed_error_pct", kMaxSpeedErrorPct, &GaitMetrics::speed_error_pct},
     {"max_joint_speed_deg_s", kMaxJointSpeedDegS, &GaitMetrics::max_joint_speed_deg_s},
+    {"obstacle_penetration_mm", kMaxObstaclePenetrationMm, &GaitMetrics::obstacle_penetration_mm},
 };
 inline constexpr int kSweepMetricCount = static_cast<int>(sizeof(kSweepMetrics) / sizeof(kSweepMetrics[0]));
 

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "runtime/gait/puppet.hpp"
+#include "runtime/gait/steering.hpp"
 #include "runtime/anim/skeleton.hpp"
 #include "runtime/anim/two_bone_ik.hpp"
 
@@ -29,7 +30,6 @@ float horizontal_distance(vec3 a, vec3 b) {
 float approach(float value, float target, float rate, float dt) { return value + (target - value) * minf(1.0f, rate * dt); }
 // v limited to [−limit, limit] (limit ≥ 0).
 double clamp_magnitude(double v, double limit) { return v > limit ? limit : (v < -limit ? -limit : v); }
-float clamp_magnitude(float v, float limit) { return v > limit ? limit : (v < -limit ? -limit : v); }
 
 struct HeadingFrame {
     vec3 forward;  // (sin h, 0, cos h)
@@ -120,6 +120,12 @@ Placement place_foot(const Terrain& terrain, const GaitRig& rig, float x, float 
         const vec3 p = ankle + quat_rotate(rotation, vec3(0.0f, -rig.ankle_height, ahead)) + vec3(0.0f, lift, 0.0f);
         misfit = maxf(misfit, query_ground(terrain, p.x, p.z).height - p.y - 0.02f);
     }
+    // Right at the tip the toes sweep forward before the foot has risen: no
+    // ground there may stand above the sole's plane at all.
+    for (float ahead : {tip + 0.01f, tip + 0.03f}) {
+        const vec3 p = ankle + quat_rotate(rotation, vec3(0.0f, -rig.ankle_height, ahead)) + vec3(0.0f, lift, 0.0f);
+        misfit = maxf(misfit, query_ground(terrain, p.x, p.z).height - p.y);
+    }
     // Nor may the heel hang against a riser behind it: the swing comes down past
     // an edge one path key (a few cm) before it lands, so ground behind the
     // ankle rising above the sole would be clipped on the way down.
@@ -158,8 +164,14 @@ float foot_phase(float cycle_phase, int foot) { return frac(cycle_phase - (foot 
 // time, so the toes point where the swing path's clearance floor looked for
 // them (build_swing_path); s already eases in and out over the swing (the
 // prototype's progress has zero tangents at both ends), so no further easing.
+// The toes keep their lift-off direction for the first kHoldRotationShare of
+// the step and reach their landing direction kHoldRotationShare before its end,
+// so a foot planted beside a riser lifts before its toes sweep toward it (the
+// path's clearance floor starts at its second key).
+constexpr float kHoldRotationShare = 0.1f;
 quat swing_rotation(const FootState& f, float s) {
-    return quat_slerp(f.start_rotation, f.target_rotation, s);
+    const float turn = clampf((s - kHoldRotationShare) / (1.0f - 2.0f * kHoldRotationShare), 0.0f, 1.0f);
+    return quat_slerp(f.start_rotation, f.target_rotation, turn);
 }
 
 // The swing path's Hermite keys from its heights: key i at s = i / (n − 1),
@@ -307,57 +319,85 @@ StepPlan step_plan(const GaitConfig& c, float speed, float commanded, bool turni
     return {step_duration(c, ahead), duty_for(c, ahead)};
 }
 
-struct Landing {
-    float time;        // s until the swing foot lands
-    float distance;    // the root's travel until then
-    float end_speed;   // the speed then
+// What the phases after steering read: the fixed inputs and what steering decided.
+struct GaitTick {
+    const GaitConfig& c;
+    const GaitRig& rig;
+    const Terrain& terrain;
+    float dt;
+    float heading;          // after this tick's turn
+    float desired_heading;  // where the root is aimed: the stick's direction, or along a face it slides on
+    HeadingFrame h;         // of `heading`
+    StepPlan plan;          // this tick's step duration and duty
+    float dphase;           // how far the cycle phase moves this tick
+    SteerGoal goal;         // the stick's ask (speed 0: released), for the path prediction
+    float target_speed;     // what the speed moved toward this tick
+    const NearbyWalls& walls;
 };
-// Runs the speed (approaching the command at the configured acceleration) and the
-// step clock (whose rate follows the speed) forward tick by tick until the foot's
-// phase completes: the same arithmetic as the tick, so the landing time and the
-// root's position then are what will really happen if the stick holds.
-Landing predict_landing(const GaitConfig& c, float speed, float commanded, float remaining_phase, bool turning, float dt) {
-    Landing out{0.0f, 0.0f, speed};
+
+// What the steering law and the step clock will do if the stick holds: where
+// the root is, and how it faces, when a swing lands and half the foot's coming
+// stance later (under the hip then is where the foot should be planted).
+struct PathPrediction {
+    float time = 0.0f;     // s until the swing foot lands
+    RootMotion landing;    // the root then
+    RootMotion mid_stance; // … and half its coming stance later
+};
+
+constexpr int kMaxPredictedTicks = 1200;
+constexpr float kMaxTurnPerStepDeg = 90.0f;  // most a foot turns in one swing
+constexpr float kMaxFootTurnDegS = 300.0f;   // … and on average per second of the swing
+// Radians a foot may turn in a swing landing in `seconds`.
+double max_foot_turn(float seconds) { return minf(kMaxTurnPerStepDeg, kMaxFootTurnDegS * seconds) * det::kDegToRad; }
+
+// Runs the tick's own steering law (steer_root: turns, braking, walls) and step
+// clock forward tick by tick from this tick's root until the foot's phase
+// completes, then half the stance that follows, so the landing time and the
+// root's place and heading then are what will really happen if the stick holds.
+PathPrediction predict_path(const GaitState& g, const GaitTick& t, vec3 root, float remaining_phase) {
+    PathPrediction out;
+    RootMotion m{root.x, root.z, t.heading, g.speed, g.turning_in_place};
     float phase_left = remaining_phase;
-    const float max_dv = c.acceleration * dt;
-    for (int k = 0; k < 1200 && phase_left > 0.0f; ++k) {
-        if (!turning) {
-            const float dv = commanded - out.end_speed;
-            out.end_speed += clamp_magnitude(dv, max_dv);
-        }
-        out.distance += out.end_speed * dt;
-        phase_left -= dt / (2.0f * step_plan(c, out.end_speed, commanded, turning).duration);
-        out.time += dt;
+    float target = t.target_speed;
+    int k = 0;
+    for (; k < kMaxPredictedTicks && phase_left > 0.0f; ++k) {
+        if (t.goal.speed > 0.0f) target = steer_root(m, t.goal, t.walls, t.c, t.dt).target_speed;
+        phase_left -= t.dt / (2.0f * step_plan(t.c, m.speed, target, m.turning_in_place != 0).duration);
+        out.time += t.dt;
     }
+    out.landing = m;
+    const StepPlan next = step_plan(t.c, m.speed, target, m.turning_in_place != 0);
+    float stance_left = next.duty * next.duration;  // half of duty · 2 · duration
+    for (; k < kMaxPredictedTicks && stance_left > 0.0f; ++k) {
+        if (t.goal.speed > 0.0f) steer_root(m, t.goal, t.walls, t.c, t.dt);
+        stance_left -= t.dt;
+    }
+    out.mid_stance = m;
     return out;
 }
 
-// Where a swing starting now should land: ahead of the root's predicted position
-// at landing by half the distance it covers during the coming stance, beside the
-// heading at the hip's lateral offset, on a flat spot of the terrain.
-Placement plan_target(const GaitState& g, int foot, vec3 root, float heading, float desired_heading, const GaitConfig& c,
-                      const GaitRig& rig, const Terrain& terrain, float remaining_phase, float dt) {
-    const Landing predicted = predict_landing(c, g.speed, g.commanded_speed, remaining_phase, false, dt);
-    const float time_to_land = predicted.time;
-    const double turn = det::wrap_angle(static_cast<double>(desired_heading) - heading);
-    const double max_turn = c.turn_rate_deg_s * det::kDegToRad * time_to_land;
-    const double landing_heading = heading + clamp_magnitude(turn, max_turn);
-    const HeadingFrame now = heading_frame(heading);
-    const HeadingFrame then = heading_frame(landing_heading);
-    // Mean direction of travel over the swing.
-    const vec3 travel = normalize3(now.forward + then.forward, now.forward);
-    const vec3 root_then = root + travel * predicted.distance;
-    const StepPlan next = step_plan(c, predicted.end_speed, g.commanded_speed, false);
-    const float stance_time = next.duty * 2.0f * next.duration;
-    float ahead = predicted.end_speed * stance_time * 0.5f;
-    if (g.first_step) ahead *= 0.5f;
-    const vec3 spot = root_then + then.forward * ahead + then.left * (side_sign(foot) * rig.hip_half_width);
-    return place_foot_on_flat_spot(terrain, rig, spot.x, spot.z, then.forward);
+// Where a swing starting now should land: under its hip at the middle of its
+// coming stance on the predicted path (the first step from standstill half as
+// far ahead of the root at landing), facing the heading then, on a flat spot of
+// the terrain. On a straight path at constant speed this is ahead of the root
+// at landing by half the distance it covers during the stance.
+Placement plan_target(const GaitState& g, const GaitTick& t, int foot, vec3 root, float remaining_phase) {
+    const PathPrediction p = predict_path(g, t, root, remaining_phase);
+    const HeadingFrame then = heading_frame(p.mid_stance.heading);
+    vec3 under(p.mid_stance.x, 0.0f, p.mid_stance.z);
+    if (g.first_step) under = 0.5f * (under + vec3(p.landing.x, 0.0f, p.landing.z));
+    const vec3 spot = under + then.left * (side_sign(foot) * t.rig.hip_half_width);
+    // The foot turns at most kMaxTurnPerStepDeg in one swing, and no faster than
+    // kMaxFootTurnDegS on average (a sharp turn takes more steps to face round).
+    const vec3 toes = quat_rotate(g.feet[static_cast<std::size_t>(foot)].rotation, vec3(0.0f, 0.0f, 1.0f));
+    const double yaw = det::atan2(toes.x, toes.z);
+    const double facing = yaw + clamp_magnitude(det::wrap_angle(static_cast<double>(p.mid_stance.heading) - yaw),
+                                                max_foot_turn(p.time));
+    return place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, heading_frame(facing).forward);
 }
 
 constexpr float kShortestSwing = 0.12f;           // s: a late lift-off still swings this long
 constexpr float kWristDrag = 0.4f;                // hand tilt against its path's velocity, per m/cycle
-constexpr float kMaxTurnPerStepDeg = 90.0f;       // turning in place: most a foot turns in one swing
 constexpr float kMaxPelvisVerticalSpeed = 0.9f;   // m/s the pelvis follows its height target at, at most
 
 // Standing spot for a foot beside the other (planted) foot.
@@ -429,7 +469,6 @@ namespace {
 
 // update_gait's constants (docs/gait.md). The doubles enter double arithmetic
 // (angles), the floats float arithmetic, exactly as the literals did.
-constexpr double kEndTurnInPlaceDeg = 20.0;        // a turn in place ends once the stick is this close to the heading
 constexpr double kStepTurnRad = 0.2;               // a wider turn is stepped even at zero speed; its side picks the lead foot
 constexpr float kForceReaim = -1.0f;               // a planned_speed no command has: the swing re-aims at its next check
 constexpr float kStepsPerCycle = 2.0f;             // a gait cycle is one left and one right step
@@ -443,6 +482,8 @@ constexpr float kMinSwingPhaseShare = 1e-3f;       // least (1 − lift phase) a
 constexpr float kReaimSpeedChange = 0.25f;         // m/s: a commanded speed change this large re-aims a swing
 constexpr double kReaimHeadingChangeRad = 0.25;    // rad: a stick direction change this large re-aims a swing
 constexpr float kLatestReaimProgress = 0.6f;       // a swing further along keeps its target
+constexpr float kStanceReachM = 0.42f;             // m: the root keeps each planted foot this close to its hip, horizontally
+constexpr std::int32_t kMaxReaims = 3;             // a swing re-aims at most this often (the stick turning on)
 constexpr float kMinReaimShiftM = 0.06f;           // m: a new target closer than this to the old one is not taken
 constexpr float kStopStaggerM = 0.05f;             // m: feet further apart along the heading close up when stopping
 constexpr float kMinClosingStepS = 0.25f;          // s: the closing step takes at least this long
@@ -454,86 +495,100 @@ constexpr float kMinHipDropShareSq = 0.09f;        // the hip stays at least 0.3
 constexpr float kMidSwingBump = 4.0f;              // 4·u·(1 − u): 0 at lift-off and landing, 1 mid-swing
 constexpr float kNoLimitM = 1e9f;                  // m: a pelvis height limit that no foot imposes
 
-// The stick's command this tick, measured against the heading before this tick's turn.
+// The stick's command this tick.
 struct StickCommand {
     float fraction = 0.0f;         // of max_speed, after deadzone and response curve
     bool moving = false;           // outside the deadzone
     float desired_heading = 0.0f;  // radians; the current heading when not moving
-    double diff = 0.0;             // desired − current heading, wrapped
-    double abs_diff = 0.0;
+    float dir_x = 0.0f, dir_z = 1.0f;  // the stick's direction in XZ (unit), when moving
 };
 
 // Stick → commanded speed fraction and direction (stick up walks toward −Z).
 StickCommand read_stick(const GaitTickInput& in, const GaitConfig& c, float heading) {
     StickCommand cmd;
-    const float deflection = minf(1.0f, std::sqrt(in.stick_x * in.stick_x + in.stick_y * in.stick_y));
-    cmd.fraction = stick_speed_fraction(deflection, c);
+    const float length = std::sqrt(in.stick_x * in.stick_x + in.stick_y * in.stick_y);
+    cmd.fraction = stick_speed_fraction(minf(1.0f, length), c);
     cmd.moving = cmd.fraction > 0.0f;
     cmd.desired_heading = heading;
-    if (cmd.moving) cmd.desired_heading = static_cast<float>(det::atan2(in.stick_x, -in.stick_y));
-    cmd.diff = det::wrap_angle(static_cast<double>(cmd.desired_heading) - heading);
-    cmd.abs_diff = cmd.diff < 0 ? -cmd.diff : cmd.diff;
+    if (cmd.moving) {
+        cmd.desired_heading = static_cast<float>(det::atan2(in.stick_x, -in.stick_y));
+        cmd.dir_x = in.stick_x / length;
+        cmd.dir_z = -in.stick_y / length;
+    }
     return cmd;
 }
 
-// Wide reversals turn in place until the stick is close to the heading again
-// (hysteresis); swings aimed for one way of moving re-aim for the other.
-void update_turning_in_place(GaitState& g, double abs_diff, const GaitConfig& c) {
-    const std::int32_t was_turning = g.turning_in_place;
-    if (abs_diff > c.turn_in_place_deg * det::kDegToRad) g.turning_in_place = 1;
-    else if (abs_diff < kEndTurnInPlaceDeg * det::kDegToRad) g.turning_in_place = 0;
-    if (was_turning != g.turning_in_place)
-        for (FootState& f : g.feet) {
-            f.replanned = 0;
-            f.planned_speed = kForceReaim;
+// The planted feet's horizontal distances from their hips (−1: swinging).
+struct StanceReach {
+    float distance[2] = {-1.0f, -1.0f};
+};
+StanceReach stance_reach(const GaitState& g, vec3 root, float heading, const GaitRig& rig) {
+    StanceReach r;
+    const HeadingFrame h = heading_frame(heading);
+    for (int i = 0; i < 2; ++i) {
+        const FootState& f = g.feet[static_cast<std::size_t>(i)];
+        if (!f.swinging) r.distance[i] = horizontal_distance(root + h.left * (side_sign(i) * rig.hip_half_width), f.ankle);
+    }
+    return r;
+}
+
+// The root pivots on the planted feet: it never takes a hip further than
+// kStanceReachM (or, if it already was, than it was before this tick) from its
+// planted foot, so a stick that turned after a foot was planted swings the body
+// round that foot instead of dragging the leg out of reach.
+void keep_stance_in_reach(const GaitState& g, vec3& root, const HeadingFrame& h, const GaitRig& rig, const StanceReach& before) {
+    for (int pass = 0; pass < 2; ++pass)
+        for (int i = 0; i < 2; ++i) {
+            const FootState& f = g.feet[static_cast<std::size_t>(i)];
+            if (f.swinging || before.distance[i] < 0.0f) continue;
+            const vec3 hip = root + h.left * (side_sign(i) * rig.hip_half_width);
+            const float dx = hip.x - f.ankle.x, dz = hip.z - f.ankle.z;
+            const float d = std::sqrt(dx * dx + dz * dz);
+            const float limit = maxf(kStanceReachM, before.distance[i]);
+            if (d <= limit) continue;
+            const float back = 1.0f - limit / d;
+            root.x -= dx * back;
+            root.z -= dz * back;
         }
 }
 
-// The heading turns toward the stick at turn_rate_deg_s; the speed approaches
-// the command (slowed on slopes along the new heading) at the configured
-// acceleration, and is zero while turning in place. A released stick stops at once.
-void steer(GaitState& g, float& heading, const StickCommand& cmd, vec3 root, const GaitConfig& c, const Terrain& terrain,
-           float dt) {
+// What steering decided this tick.
+struct Steering {
+    SteerGoal goal;
+    SteerResult result;
+};
+
+// The root moves by the steering law (steer_root, runtime/gait/steering.hpp):
+// the stick's velocity clipped against obstacles, the heading turned no faster
+// than the lateral acceleration allows, the speed braked for sharp turns and
+// wide reversals turned in place once braked. A released stick stops at once.
+// Swings aimed for one way of moving re-aim when turning in place starts or ends.
+Steering steer(GaitState& g, float& heading, vec3& root, const StickCommand& cmd, const NearbyWalls& walls,
+               const GaitConfig& c, const Terrain& terrain, float dt) {
+    Steering s;
+    s.result.heading = heading;
     if (!cmd.moving) {
         g.commanded_speed = 0.0f;
         g.speed = 0.0f;  // stopping is immediate in movement
         g.turning_in_place = 0;
-        return;
+        return s;
     }
-    update_turning_in_place(g, cmd.abs_diff, c);
-    const double max_turn = c.turn_rate_deg_s * det::kDegToRad * dt;
-    heading = static_cast<float>(det::wrap_angle(heading + clamp_magnitude(cmd.diff, max_turn)));
     g.commanded_speed = c.max_speed * cmd.fraction * slope_speed_multiplier(terrain, c, root.x, root.z, heading);
-    if (g.turning_in_place) {
-        g.speed = 0.0f;  // immediate: no walking backwards
-    } else {
-        const float dv = g.commanded_speed - g.speed;
-        const float max_dv = c.acceleration * dt;
-        g.speed += clamp_magnitude(dv, max_dv);
-    }
+    s.goal = {cmd.dir_x, cmd.dir_z, cmd.desired_heading, g.commanded_speed};
+    RootMotion m{root.x, root.z, heading, g.speed, g.turning_in_place};
+    s.result = steer_root(m, s.goal, walls, c, dt);
+    if (m.turning_in_place != g.turning_in_place)
+        for (FootState& f : g.feet) {
+            f.replanned = 0;
+            f.planned_speed = kForceReaim;
+        }
+    g.turning_in_place = m.turning_in_place;
+    g.speed = m.speed;
+    heading = m.heading;
+    root.x = m.x;
+    root.z = m.z;
+    return s;
 }
-
-// The root travels along the (new) heading at the (new) speed.
-HeadingFrame move_root(const GaitState& g, float heading, vec3& root, vec2& velocity, float dt) {
-    const HeadingFrame h = heading_frame(heading);
-    velocity = vec2(h.forward.x * g.speed, h.forward.z * g.speed);
-    root.x += velocity.x * dt;
-    root.z += velocity.y * dt;
-    return h;
-}
-
-// What the phases after steering read: the fixed inputs and what steering decided.
-struct GaitTick {
-    const GaitConfig& c;
-    const GaitRig& rig;
-    const Terrain& terrain;
-    float dt;
-    float heading;          // after this tick's turn
-    float desired_heading;  // the stick's direction
-    HeadingFrame h;         // of `heading`
-    StepPlan plan;          // this tick's step duration and duty
-    float dphase;           // how far the cycle phase moves this tick
-};
 
 // Idle or stopping → stepping. From idle the first step (half length) leads with
 // the foot on the side of the turn, else the left.
@@ -575,24 +630,24 @@ void change_mode(GaitState& g, const GaitTick& t, vec3 root, bool wants_steps, d
 // Where foot i, lifting (or re-aiming) at its phase psi, should land.
 Placement aim_swing(const GaitState& g, const GaitTick& t, vec3 root, int i, float psi) {
     if (!g.turning_in_place)
-        return plan_target(g, i, root, t.heading, t.desired_heading, t.c, t.rig, t.terrain, 1.0f - psi, t.dt);
+        return plan_target(g, t, i, root, 1.0f - psi);
     // Turning in place: small steps to the hip's spot under the turned heading.
-    const float time_to_land = predict_landing(t.c, g.speed, g.commanded_speed, 1.0f - psi, true, t.dt).time;
+    const float time_to_land = predict_path(g, t, root, 1.0f - psi).time;
     const double turn = det::wrap_angle(static_cast<double>(t.desired_heading) - t.heading);
     // Small steps: a foot turns at most kMaxTurnPerStepDeg per swing.
-    const double max_turn = minf(t.c.turn_rate_deg_s * time_to_land, kMaxTurnPerStepDeg) * det::kDegToRad;
+    const double max_turn = minf(minf(t.c.turn_rate_deg_s, kMaxFootTurnDegS) * time_to_land, kMaxTurnPerStepDeg) * det::kDegToRad;
     const HeadingFrame then = heading_frame(t.heading + clamp_magnitude(turn, max_turn));
     const vec3 spot = root + then.left * (side_sign(i) * t.rig.hip_half_width);
     return place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, then.forward);
 }
 
-// A swing re-aims once, early in the swing, if the stick changed the landing spot a lot.
+// A swing re-aims (up to kMaxReaims times, early in the swing) when the stick changed the landing spot a lot.
 void reaim_if_command_changed(GaitState& g, const GaitTick& t, vec3 root, int i) {
     FootState& f = g.feet[static_cast<std::size_t>(i)];
     const bool command_changed =
         std::fabs(g.commanded_speed - f.planned_speed) > kReaimSpeedChange ||
         std::fabs(det::wrap_angle(static_cast<double>(t.desired_heading) - f.planned_heading)) > kReaimHeadingChangeRad;
-    const bool may_reaim = g.mode == GaitMode::stepping && command_changed && !f.replanned && f.timed_rate == 0.0f &&
+    const bool may_reaim = g.mode == GaitMode::stepping && command_changed && f.replanned < kMaxReaims && f.timed_rate == 0.0f &&
                            f.progress < kLatestReaimProgress;
     if (!may_reaim) return;
     const float psi = foot_phase(g.cycle_phase, i);
@@ -601,7 +656,7 @@ void reaim_if_command_changed(GaitState& g, const GaitTick& t, vec3 root, int i)
         const float ground = f.ground;
         begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
         f.start_ground = ground;
-        f.replanned = 1;
+        ++f.replanned;
     }
     f.planned_speed = g.commanded_speed;
     f.planned_heading = t.desired_heading;
@@ -774,12 +829,18 @@ void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const
                  const GaitRig& rig, const Terrain& terrain) {
     const float dt = in.dt;
     const StickCommand cmd = read_stick(in, c, heading);
-    steer(g, heading, cmd, root, c, terrain, dt);
-    const HeadingFrame h = move_root(g, heading, root, velocity, dt);
-    const bool wants_steps = cmd.moving && (g.speed > 0.0f || g.turning_in_place || cmd.abs_diff > kStepTurnRad);
-    const StepPlan plan = step_plan(c, g.speed, g.commanded_speed, g.turning_in_place != 0);
-    const GaitTick t{c, rig, terrain, dt, heading, cmd.desired_heading, h, plan, dt / (kStepsPerCycle * plan.duration)};
-    change_mode(g, t, root, wants_steps, cmd.diff);
+    const NearbyWalls walls = cmd.moving ? find_nearby_walls(terrain, c, root) : NearbyWalls{};
+    const StanceReach reach = stance_reach(g, root, heading, rig);
+    const Steering s = steer(g, heading, root, cmd, walls, c, terrain, dt);
+    const HeadingFrame h = heading_frame(heading);
+    keep_stance_in_reach(g, root, h, rig, reach);
+    velocity = vec2(h.forward.x * g.speed, h.forward.z * g.speed);
+    const double abs_diff = s.result.diff < 0 ? -s.result.diff : s.result.diff;
+    const bool wants_steps = cmd.moving && (g.speed > 0.0f || g.turning_in_place || abs_diff > kStepTurnRad);
+    const StepPlan plan = step_plan(c, g.speed, s.result.target_speed, g.turning_in_place != 0);
+    const GaitTick t{c,    rig,  terrain, dt, heading, s.result.heading, h, plan, dt / (kStepsPerCycle * plan.duration),
+                     s.goal, s.result.target_speed, walls};
+    change_mode(g, t, root, wants_steps, s.result.diff);
     advance_feet(g, t, root);
     finish_stopping(g, t);
     count_flight_phases(g);

@@ -121,7 +121,7 @@ TEST_CASE("running has flight phases and walking never does", "[gait]") {
     CHECK(flight_ticks(2.6) > 60);
 }
 
-TEST_CASE("heading follows the stick at the turn rate and a reversal turns in place", "[gait]") {
+TEST_CASE("heading follows the stick at the turn rate and a reversal from a walk turns in place", "[gait]") {
     const SimConfig c;
     Simulation sim(c);
     run_ticks(sim, stick(0.0, 0.7), 240 * 3);  // walking toward −Z
