@@ -163,10 +163,11 @@ float duty_for(const GaitConfig& c, float speed) { return running(c, speed) ? c.
 
 float foot_phase(float cycle_phase, int foot) { return frac(cycle_phase - (foot == 0 ? 0.0f : 0.5f)); }
 
-// The foot's rotation at step fraction s. It turns with the path, not with
-// time, so the toes point where the swing path's clearance floor looked for
-// them (build_swing_path); s already eases in and out over the swing (the
-// prototype's progress has zero tangents at both ends), so no further easing.
+// The foot's rotation at the share s of the step's horizontal distance covered
+// (key_reach at the keys). It turns with the path, not with time, so the toes
+// point where the swing path's clearance floor looked for them
+// (build_swing_path), and not during the straight lift-off and set-down; s
+// already eases in and out over the swing, so no further easing.
 quat swing_rotation(const FootState& f, float s) {
     return quat_slerp(f.start_rotation, f.target_rotation, s);
 }
@@ -240,7 +241,7 @@ void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, 
     // The toes at a key point between their directions at the neighbouring keys.
     std::array<vec3, n> toe_direction{};
     for (int i = 0; i < n; ++i)
-        toe_direction[static_cast<std::size_t>(i)] = quat_rotate(swing_rotation(f, key_fraction(i)), vec3(0.0f, 0.0f, 1.0f));
+        toe_direction[static_cast<std::size_t>(i)] = quat_rotate(swing_rotation(f, key_reach(i)), vec3(0.0f, 0.0f, 1.0f));
     std::array<float, n> ground{};
     for (int i = 0; i < n; ++i) {
         const vec3 a = lerp(f.start, f.target, key_reach(i));
@@ -277,7 +278,7 @@ void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, 
         // own spot) need the full clearance only below a riser next to the
         // spot; else they rise kLiftOffClearanceM, so a step on level ground
         // does not start with a jerk straight up.
-        if (i == 1 || i == n - 2) {
+        if ((i == 1 || i == n - 2) && f.lift_scale >= 1.0f) {
             const std::size_t next = i == 1 ? k + 1 : k - 1;
             if (!(ground[next] > ground[k] + kRiserM)) floor = ground[k] + rig.ankle_height + kLiftOffClearanceM;
         }
@@ -329,7 +330,7 @@ void evaluate_swing(FootState& f, int foot, const GaitConfig& c, const GaitRig& 
     vec3 p = lerp(f.start, f.target, reach) + left * (side_sign(foot) * shape.x * f.lift_scale);
     p.y = on_path.y;
     f.ankle = p;
-    f.rotation = swing_rotation(f, s);
+    f.rotation = swing_rotation(f, reach);
     f.ground = f.start_ground + (f.target_ground - f.start_ground) * reach;
 }
 
@@ -525,6 +526,8 @@ constexpr float kPelvisBaseRateScale = 1.5f;       // the pelvis base follows th
 constexpr float kFullLegReachShare = 0.995f;       // mid-swing the hip may be this share of thigh + shin from the ankle
 constexpr float kMinHipDropShareSq = 0.09f;        // the hip stays at least 0.3 of the reach (squared: 0.09) above the ankle
 constexpr float kMidSwingBump = 4.0f;              // 4·u·(1 − u): 0 at lift-off and landing, 1 mid-swing
+constexpr float kEarlyLiftPhase = 0.05f;          // … at most this much of a cycle before its duty factor
+constexpr float kEarlyLiftReachShare = 0.9f;      // a planted foot this share of the leg reach behind its hip lifts
 constexpr float kNoLimitM = 1e9f;                  // m: a pelvis height limit that no foot imposes
 
 // The stick's command this tick, measured against the heading before this tick's turn.
@@ -709,7 +712,13 @@ void lift_if_due(GaitState& g, const GaitTick& t, vec3 root, int i) {
     const FootState& other = g.feet[static_cast<std::size_t>(1 - i)];
     const float psi = foot_phase(g.cycle_phase, i);
     const bool walking = !running(t.c, g.speed);
-    if (psi >= t.plan.duty && (!walking || !other.swinging)) {
+    // A foot left far behind its hip (a start down a slope, a long first
+    // stride) lifts early, while the other is planted, instead of being dragged
+    // out of the leg's reach.
+    const vec3 hip = root + t.h.left * (side_sign(i) * t.rig.hip_half_width);
+    const bool left_behind = !other.swinging && psi >= t.plan.duty - kEarlyLiftPhase &&
+                             dot3(hip - f.ankle, t.h.forward) > kEarlyLiftReachShare * t.rig.leg_reach;
+    if ((psi >= t.plan.duty && (!walking || !other.swinging)) || left_behind) {
         begin_swing(f, aim_swing(g, t, root, i, psi), t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
         f.planned_speed = g.commanded_speed;
         f.planned_heading = t.desired_heading;
