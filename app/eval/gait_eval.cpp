@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -242,7 +243,8 @@ public:
               const std::vector<TickInput>& ticks, std::vector<Hold> holds, std::vector<StickTurn> turns, bool feet_csv,
               GaitMetrics& m)
         : config_(config), sim_(sim), terrain_(sim.terrain()), puppet_(puppet), ticks_(ticks), holds_(std::move(holds)),
-          turns_(std::move(turns)), turn_index_(turns_.size(), -1), m_(m), previous_(sim.state()), path_(holds_.size(), 0.0), expected_(holds_.size(), 0.0),
+          turns_(std::move(turns)), turn_index_(turns_.size(), -1), m_(m), previous_(sim.state()), path_(holds_.size(), 0.0),
+          expected_(holds_.size(), 0.0), following_(holds_.size(), 0.0),
           last_sample_(holds_.size()), sample_every_(static_cast<std::uint64_t>(config.tick_rate_hz / 4)) {
         for (int i = 0; i < 2; ++i)
             stance_anchor_[i] = sim.state().model_positions[static_cast<std::size_t>(puppet.feet[i].ankle)];
@@ -409,9 +411,17 @@ private:
                 const double sy = ticks_[k].left_y / static_cast<double>(kStickScale);
                 expected_[h] += puppet_.graph_full_speed_m_s * std::sqrt(sx * sx + sy * sy);
             } else {
+                // The command on this ground (ground_speed: slope factor and the
+                // climb cap, docs/gait.md), followed at the configured acceleration
+                // as the gait follows it: on stairs and changing slopes the command
+                // changes under the puppet, and a speed cannot jump.
                 const float deflection = std::min(1.0f, std::sqrt(hold.stick_x * hold.stick_x + hold.stick_y * hold.stick_y));
-                expected_[h] += config_.max_speed * stick_speed_fraction(deflection, config_) *
-                                slope_speed_multiplier(terrain_, config_, pelvis.x, pelvis.z, s.heading);
+                const double command = ground_speed(terrain_, config_, stick_speed_fraction(deflection, config_), pelvis.x,
+                                                    pelvis.z, s.heading);
+                const double max_change = config_.acceleration / config_.tick_rate_hz;
+                if (k == hold.first_tick) following_[h] = command;
+                else following_[h] += std::clamp(command - following_[h], -max_change, max_change);
+                expected_[h] += following_[h];
             }
             if (k == hold.first_tick) last_sample_[h] = pelvis;
             else if ((k - hold.first_tick) % sample_every_ == 0 || k + 1 == hold.end_tick) {
@@ -437,7 +447,7 @@ private:
     vec3 stance_anchor_[2];
     bool was_stance_[2] = {true, true};
     // Per hold: pelvis path length (sampled every quarter second) and expected speed.
-    std::vector<double> path_, expected_;
+    std::vector<double> path_, expected_, following_;
     std::vector<vec3> last_sample_;
     const std::uint64_t sample_every_;
     std::string csv_;  // the feet CSV, when asked for

@@ -98,8 +98,19 @@ struct Placement {
     float misfit;  // how far the sole had to rise to clear its toes, or a riser just ahead is above it
 };
 
+// A foot fits the ground when its sole, from kHeelMarginM behind the ankle to
+// kToeMarginM past the toe tip, lies on one surface (docs/gait.md): no heel or
+// toe over an edge, no toe against a riser.
+constexpr float kHeelMarginM = 0.015f;
+constexpr float kToeMarginM = 0.025f;
+constexpr float kEdgeDropM = 0.02f;      // ground this far below the sole plane is past an edge
+constexpr float kFitTolerance = 0.004f;  // m of misfit a spot may have
+constexpr float kSpotSearchStepM = 0.005f;
+constexpr int kSpotSearchSteps = 34;     // on each side: up to 17 cm along the heading
+
 // A planted foot at (x, z): sole on the surface, aligned to the normal there and
-// to `forward`; raised just enough that no sole point is below the ground.
+// to `forward` (pitch and roll to the surface); raised just enough that no sole
+// point is below the ground.
 Placement place_foot(const Terrain& terrain, const GaitRig& rig, float x, float z, vec3 forward) {
     const GroundSample g = query_ground(terrain, x, z);
     const vec3 n = g.normal;
@@ -112,41 +123,33 @@ Placement place_foot(const Terrain& terrain, const GaitRig& rig, float x, float 
         const vec3 p = ankle + quat_rotate(rotation, o);
         lift = maxf(lift, query_ground(terrain, p.x, p.z).height - p.y);
     }
-    // A riser just ahead of the toes would be kicked at lift-off: count ground
-    // within 12 cm ahead rising more than 2 cm above the sole's plane as misfit.
+    // Misfit: how far the sole had to rise, ground rising above the sole plane
+    // just past the toes or behind the heel (a riser the toes would kick at
+    // lift-off, or the heel would be clipped against coming down), and ground
+    // dropping away under the margins or the sole points (over an edge).
     float misfit = lift;
     const float tip = rig.foot_length + rig.toe_length;
-    for (float ahead : {tip + 0.06f, tip + 0.12f}) {
-        const vec3 p = ankle + quat_rotate(rotation, vec3(0.0f, -rig.ankle_height, ahead)) + vec3(0.0f, lift, 0.0f);
-        misfit = maxf(misfit, query_ground(terrain, p.x, p.z).height - p.y - 0.02f);
-    }
-    // Right at the tip the toes sweep forward before the foot has risen: no
-    // ground there may stand above the sole's plane at all.
-    for (float ahead : {tip + 0.01f, tip + 0.03f}) {
-        const vec3 p = ankle + quat_rotate(rotation, vec3(0.0f, -rig.ankle_height, ahead)) + vec3(0.0f, lift, 0.0f);
-        misfit = maxf(misfit, query_ground(terrain, p.x, p.z).height - p.y);
-    }
-    // Nor may the heel hang against a riser behind it: the swing comes down past
-    // an edge one path key (a few cm) before it lands, so ground behind the
-    // ankle rising above the sole would be clipped on the way down.
-    for (float behind : {0.04f, 0.08f}) {
-        const vec3 p = ankle + quat_rotate(rotation, vec3(0.0f, -rig.ankle_height, -behind)) + vec3(0.0f, lift, 0.0f);
-        misfit = maxf(misfit, query_ground(terrain, p.x, p.z).height - p.y);
+    for (float along : {-kHeelMarginM, 0.0f, rig.foot_length, tip, tip + kToeMarginM}) {
+        const vec3 p = ankle + quat_rotate(rotation, vec3(0.0f, -rig.ankle_height, along)) + vec3(0.0f, lift, 0.0f);
+        const float above = query_ground(terrain, p.x, p.z).height - p.y;
+        misfit = maxf(misfit, maxf(above - lift, -above - lift - kEdgeDropM));
     }
     return {ankle + vec3(0.0f, lift, 0.0f), rotation, g.height + lift, misfit};
 }
 
-// The nearest spot along `forward` (within ±20 cm) where the whole sole rests
-// on one surface, so feet never land straddling a step edge.
+// The nearest spot along `forward` (within kSpotSearchSteps steps either way)
+// where the whole sole rests on one surface, so feet never land straddling a
+// step edge: on stairs this fits each step to the treads.
 Placement place_foot_on_flat_spot(const Terrain& terrain, const GaitRig& rig, float x, float z, vec3 forward) {
     Placement best = place_foot(terrain, rig, x, z, forward);
-    if (best.misfit < 0.004f) return best;
-    static constexpr float kOffsets[] = {-0.04f, 0.04f, -0.08f, 0.08f, -0.12f, 0.12f, -0.16f, 0.16f, -0.2f, 0.2f};
-    for (float d : kOffsets) {
-        const Placement p = place_foot(terrain, rig, x + forward.x * d, z + forward.z * d, forward);
-        if (p.misfit < 0.004f) return p;
-        if (p.misfit < best.misfit) best = p;
-    }
+    if (best.misfit < kFitTolerance) return best;
+    for (int k = 1; k <= kSpotSearchSteps; ++k)
+        for (float sign : {-1.0f, 1.0f}) {
+            const float d = sign * kSpotSearchStepM * static_cast<float>(k);
+            const Placement p = place_foot(terrain, rig, x + forward.x * d, z + forward.z * d, forward);
+            if (p.misfit < kFitTolerance) return p;
+            if (p.misfit < best.misfit) best = p;
+        }
     return best;
 }
 
@@ -174,26 +177,58 @@ quat swing_rotation(const FootState& f, float s) {
     return quat_slerp(f.start_rotation, f.target_rotation, turn);
 }
 
-// The swing path's Hermite keys from its heights: key i at s = i / (n − 1),
-// position (0, height, s · distance); vertical tangents are the harmonic mean of
-// the neighbouring slopes (zero at a peak, a valley and both ends), which keeps
-// each segment monotone: no overshoot above a key or dip below one.
+// Where key i of a swing path lies, as a fraction s of the step's horizontal
+// distance: on the arc-length table's grid (kArcLengthIntervals), so every
+// table interval lies inside one smooth segment and the length inversion is
+// accurate there; the first and last three intervals are one grid step each,
+// the rest two.
+constexpr std::array<int, kSwingPathKeys> kKeyGrid = {0, 1, 2, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 30, 31, 32};
+static_assert(kKeyGrid[kSwingPathKeys - 1] == kArcLengthIntervals);
+float key_fraction(int i) {
+    return static_cast<float>(kKeyGrid[static_cast<std::size_t>(i)]) / static_cast<float>(kArcLengthIntervals);
+}
+// How much of the step's horizontal distance key i has covered: none at the
+// first two keys and all at the last two, so the foot lifts off straight up and
+// sets down straight down (toes a few centimetres from a riser rise past its
+// top before they move toward it; a heel comes down onto its tread, not across
+// the edge behind it), evenly in between.
+float key_reach(int i) {
+    constexpr int n = kSwingPathKeys;
+    if (i <= 1) return 0.0f;
+    if (i >= n - 2) return 1.0f;
+    return static_cast<float>(kKeyGrid[static_cast<std::size_t>(i)] - kKeyGrid[1]) /
+           static_cast<float>(kKeyGrid[static_cast<std::size_t>(n - 2)] - kKeyGrid[1]);
+}
+// Fritsch–Butland tangent at key i of values v over key_fraction: the harmonic
+// mean of the neighbouring slopes, zero at a peak, a valley, a flat and both
+// ends, so each segment stays between its two keys (no overshoot, no dip).
+template <class Value>
+float monotone_tangent(const Value& v, int i) {
+    constexpr int n = kSwingPathKeys;
+    if (i <= 0 || i + 1 >= n) return 0.0f;
+    const std::size_t k = static_cast<std::size_t>(i);
+    const float s = key_fraction(i);
+    const float before = (v(k) - v(k - 1)) / (s - key_fraction(i - 1));
+    const float after = (v(k + 1) - v(k)) / (key_fraction(i + 1) - s);
+    return before * after > 0.0f ? 2.0f * before * after / (before + after) : 0.0f;
+}
+
+// The swing path's Hermite keys from its heights: key i at s = key_fraction(i),
+// position (0, height, key_reach(i) · distance); both coordinates have monotone
+// tangents, so the foot never moves back or overshoots a key's height.
 void swing_path_keys(const FootState& f, std::array<HermiteKey, kSwingPathKeys>& keys) {
     constexpr int n = kSwingPathKeys;
-    const float spacing = 1.0f / static_cast<float>(n - 1);
     const float distance = horizontal_distance(f.start, f.target);
+    const auto height = [&](std::size_t k) { return f.path_height[k]; };
+    const auto along = [&](std::size_t k) { return key_reach(static_cast<int>(k)) * distance; };
     for (int i = 0; i < n; ++i) {
         const std::size_t k = static_cast<std::size_t>(i);
-        const float s = static_cast<float>(i) * spacing;
-        float slope = 0.0f;
-        if (i > 0 && i + 1 < n) {
-            const float before = (f.path_height[k] - f.path_height[k - 1]) / spacing;
-            const float after = (f.path_height[k + 1] - f.path_height[k]) / spacing;
-            if (before * after > 0.0f) slope = 2.0f * before * after / (before + after);
-        }
-        keys[k] = {s, vec3(0.0f, f.path_height[k], s * distance), vec3(0.0f, slope, distance)};
+        keys[k] = {key_fraction(i), vec3(0.0f, height(k), along(k)), vec3(0.0f, monotone_tangent(height, i), monotone_tangent(along, i))};
     }
 }
+
+constexpr float kRiserM = 0.01f;             // m: ground this much above the foot's spot next to it is a riser
+constexpr float kLiftOffClearanceM = 0.005f;  // m: the straight lift-off and set-down away from risers
 
 // The swing path (docs/gait.md): the ankle's height at evenly spaced fractions
 // s of the step's horizontal distance, as a monotone cubic Hermite spline in the
@@ -211,12 +246,10 @@ void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, 
     // The toes at a key point between their directions at the neighbouring keys.
     std::array<vec3, n> toe_direction{};
     for (int i = 0; i < n; ++i)
-        toe_direction[static_cast<std::size_t>(i)] =
-            quat_rotate(swing_rotation(f, static_cast<float>(i) / static_cast<float>(n - 1)), vec3(0.0f, 0.0f, 1.0f));
+        toe_direction[static_cast<std::size_t>(i)] = quat_rotate(swing_rotation(f, key_reach(i)), vec3(0.0f, 0.0f, 1.0f));
     std::array<float, n> ground{};
     for (int i = 0; i < n; ++i) {
-        const float s = static_cast<float>(i) / static_cast<float>(n - 1);
-        const vec3 a = lerp(f.start, f.target, s);
+        const vec3 a = lerp(f.start, f.target, key_reach(i));
         float h = query_ground(terrain, a.x, a.z).height;
         const vec3 toes[3] = {toe_direction[static_cast<std::size_t>(i > 0 ? i - 1 : 0)], toe_direction[static_cast<std::size_t>(i)],
                               toe_direction[static_cast<std::size_t>(i + 1 < n ? i + 1 : n - 1)]};
@@ -238,14 +271,22 @@ void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, 
     f.path_height[0] = f.start.y;
     f.path_height[static_cast<std::size_t>(n - 1)] = f.target.y;
     for (int i = 1; i + 1 < n; ++i) {
-        const float s = static_cast<float>(i) / static_cast<float>(n - 1);
+        const float s = key_reach(i);
         while (j + 1 < m && shape_fraction[static_cast<std::size_t>(j + 1)] < s) ++j;
         const float f0 = shape_fraction[static_cast<std::size_t>(j)], f1 = shape_fraction[static_cast<std::size_t>(j + 1)];
         const float w = f1 > f0 ? clampf((s - f0) / (f1 - f0), 0.0f, 1.0f) : 1.0f;
         const float lift = shape_lift[static_cast<std::size_t>(j)] + (shape_lift[static_cast<std::size_t>(j + 1)] - shape_lift[static_cast<std::size_t>(j)]) * w;
         const float shaped = f.start.y + (f.target.y - f.start.y) * s + lift * f.lift_scale;
         const std::size_t k = static_cast<std::size_t>(i);
-        const float floor = maxf(ground[k], maxf(ground[k - 1], ground[k + 1])) + rig.ankle_height + c.swing_clearance;
+        float floor = maxf(ground[k], maxf(ground[k - 1], ground[k + 1])) + rig.ankle_height + c.swing_clearance;
+        // The straight lift-off and set-down (keys 1 and n − 2, over the foot's
+        // own spot) need the full clearance only below a riser next to the
+        // spot; else they rise kLiftOffClearanceM, so a step on level ground
+        // does not start with a jerk straight up.
+        if ((i == 1 || i == n - 2) && f.lift_scale >= 1.0f) {
+            const std::size_t next = i == 1 ? k + 1 : k - 1;
+            if (!(ground[next] > ground[k] + kRiserM)) floor = ground[k] + rig.ankle_height + kLiftOffClearanceM;
+        }
         f.path_height[k] = maxf(shaped, floor);
     }
     std::array<HermiteKey, kSwingPathKeys> keys{};
@@ -287,12 +328,15 @@ void evaluate_swing(FootState& f, int foot, const GaitConfig& c, const GaitRig& 
     const std::span<const HermiteKey> path(keys.data(), keys.size());
     const float total = f.path_length.total();
     const float s = total > 1e-6f ? clampf(time_at_arc_length(path, f.path_length, share * total), 0.0f, 1.0f) : share;
-    f.fraction = s;
-    vec3 p = lerp(f.start, f.target, s) + left * (side_sign(foot) * shape.x * f.lift_scale);
-    p.y = sample_hermite(path, s).position.y;
+    const vec3 on_path = sample_hermite(path, s).position;  // (0, height, distance along the step)
+    const float distance = horizontal_distance(f.start, f.target);
+    const float reach = distance > 1e-6f ? clampf(on_path.z / distance, 0.0f, 1.0f) : s;
+    f.fraction = reach;
+    vec3 p = lerp(f.start, f.target, reach) + left * (side_sign(foot) * shape.x * f.lift_scale);
+    p.y = on_path.y;
     f.ankle = p;
-    f.rotation = swing_rotation(f, s);
-    f.ground = f.start_ground + (f.target_ground - f.start_ground) * s;
+    f.rotation = swing_rotation(f, reach);
+    f.ground = f.start_ground + (f.target_ground - f.start_ground) * reach;
 }
 
 void land(FootState& f, GaitState& g) {
@@ -417,13 +461,36 @@ float stick_speed_fraction(float deflection, const GaitConfig& c) {
     return (1.0f - c.response_curve) * d + c.response_curve * d * d;
 }
 
-float slope_speed_multiplier(const Terrain& terrain, const GaitConfig& c, float x, float z, float heading) {
-    const vec3 n = query_ground(terrain, x, z).normal;
+namespace {
+// The ground's grade along the heading is measured over a stride-sized window
+// (kGradeBehindM behind to kGradeAheadM ahead of the point), so a flight of
+// stairs reads as its pitch (rise over tread), not as flat treads and
+// vertical risers, and the puppet slows as it reaches a flight.
+constexpr float kGradeBehindM = 0.4f;
+constexpr float kGradeAheadM = 0.8f;
+// m/s: the most the puppet climbs or descends while walking (docs/gait.md):
+// on steep ground the horizontal speed is capped at this over the grade.
+constexpr float kMaxClimbSpeed = 0.6f;
+}  // namespace
+
+float ground_grade_along(const Terrain& terrain, float x, float z, float heading) {
     const HeadingFrame h = heading_frame(heading);
-    const float grade = n.y > 1e-3f ? -(n.x * h.forward.x + n.z * h.forward.z) / n.y : 0.0f;
+    const float ahead = query_ground(terrain, x + h.forward.x * kGradeAheadM, z + h.forward.z * kGradeAheadM).height;
+    const float behind = query_ground(terrain, x - h.forward.x * kGradeBehindM, z - h.forward.z * kGradeBehindM).height;
+    return (ahead - behind) / (kGradeAheadM + kGradeBehindM);
+}
+
+float slope_speed_multiplier(const Terrain& terrain, const GaitConfig& c, float x, float z, float heading) {
+    const float grade = ground_grade_along(terrain, x, z, heading);
     if (grade == 0.0f) return 1.0f;  // level: what the formula gives, without the atan
     const double degrees = det::atan(std::fabs(static_cast<double>(grade))) * det::kRadToDeg;
     return clampf(1.0f - c.slope_speed_factor * static_cast<float>(degrees), 0.2f, 1.0f);
+}
+
+float ground_speed(const Terrain& terrain, const GaitConfig& c, float stick_fraction, float x, float z, float heading) {
+    const float grade = std::fabs(ground_grade_along(terrain, x, z, heading));
+    const float wanted = c.max_speed * stick_fraction * slope_speed_multiplier(terrain, c, x, z, heading);
+    return grade * wanted > kMaxClimbSpeed ? kMaxClimbSpeed / grade : wanted;
 }
 
 GaitRig make_gait_rig(const GaitConfig& c) {
@@ -493,6 +560,8 @@ constexpr float kPelvisBaseRateScale = 1.5f;       // the pelvis base follows th
 constexpr float kFullLegReachShare = 0.995f;       // mid-swing the hip may be this share of thigh + shin from the ankle
 constexpr float kMinHipDropShareSq = 0.09f;        // the hip stays at least 0.3 of the reach (squared: 0.09) above the ankle
 constexpr float kMidSwingBump = 4.0f;              // 4·u·(1 − u): 0 at lift-off and landing, 1 mid-swing
+constexpr float kEarlyLiftPhase = 0.05f;          // … at most this much of a cycle before its duty factor
+constexpr float kEarlyLiftReachShare = 0.9f;      // a planted foot this share of the leg reach behind its hip lifts
 constexpr float kNoLimitM = 1e9f;                  // m: a pelvis height limit that no foot imposes
 
 // The stick's command this tick.
@@ -573,7 +642,7 @@ Steering steer(GaitState& g, float& heading, vec3& root, const StickCommand& cmd
         g.turning_in_place = 0;
         return s;
     }
-    g.commanded_speed = c.max_speed * cmd.fraction * slope_speed_multiplier(terrain, c, root.x, root.z, heading);
+    g.commanded_speed = ground_speed(terrain, c, cmd.fraction, root.x, root.z, heading);
     s.goal = {cmd.dir_x, cmd.dir_z, cmd.desired_heading, g.commanded_speed};
     RootMotion m{root.x, root.z, heading, g.speed, g.turning_in_place};
     s.result = steer_root(m, s.goal, walls, c, dt);
@@ -599,7 +668,11 @@ void start_stepping(GaitState& g, const GaitTick& t, double diff) {
         g.first_step = 1;
     }
     g.mode = GaitMode::stepping;
-    for (FootState& f : g.feet) f.timed_rate = 0.0f;
+    // A foot still on its quick stop swing finishes it at its own pace (a
+    // phase-driven pace from lift phase 0 would take a whole cycle while the
+    // root walks on); it lands where it was going and steps on from there.
+    for (FootState& f : g.feet)
+        if (!f.swinging) f.timed_rate = 0.0f;
 }
 
 // Stepping → stopping: a foot in the air re-aims beside the planted one and lands quickly.
@@ -687,7 +760,13 @@ void lift_if_due(GaitState& g, const GaitTick& t, vec3 root, int i) {
     const FootState& other = g.feet[static_cast<std::size_t>(1 - i)];
     const float psi = foot_phase(g.cycle_phase, i);
     const bool walking = !running(t.c, g.speed);
-    if (psi >= t.plan.duty && (!walking || !other.swinging)) {
+    // A foot left far behind its hip (a start down a slope, a long first
+    // stride) lifts early, while the other is planted, instead of being dragged
+    // out of the leg's reach.
+    const vec3 hip = root + t.h.left * (side_sign(i) * t.rig.hip_half_width);
+    const bool left_behind = !other.swinging && psi >= t.plan.duty - kEarlyLiftPhase &&
+                             dot3(hip - f.ankle, t.h.forward) > kEarlyLiftReachShare * t.rig.leg_reach;
+    if ((psi >= t.plan.duty && (!walking || !other.swinging)) || left_behind) {
         begin_swing(f, aim_swing(g, t, root, i, psi), t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
         f.planned_speed = g.commanded_speed;
         f.planned_heading = t.desired_heading;

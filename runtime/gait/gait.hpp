@@ -92,8 +92,17 @@ GaitState initial_gait_state(const GaitConfig& config, const GaitRig& rig, const
 // Stick deflection (0..1) → speed fraction: radial deadzone, then response curve.
 float stick_speed_fraction(float deflection, const GaitConfig& config);
 
-// Degrees of slope along `heading` at (x, z) and the speed factor it gives.
+// The ground's grade (rise over run) along `heading` at (x, z), over a window
+// from 0.4 m behind to 0.8 m ahead: stairs read as their pitch (docs/gait.md).
+float ground_grade_along(const Terrain& terrain, float x, float z, float heading);
+
+// The slope factor 1 − slope_speed_factor · degrees of that grade (at least 0.2).
 float slope_speed_multiplier(const Terrain& terrain, const GaitConfig& config, float x, float z, float heading);
+
+// The speed the stick commands at (x, z): max_speed × stick fraction × slope
+// factor, capped so that the puppet climbs or descends at most 0.6 m/s. The
+// gait and gait-eval's speed expectation both use it.
+float ground_speed(const Terrain& terrain, const GaitConfig& config, float stick_fraction, float x, float z, float heading);
 
 struct GaitTickInput {
     float stick_x = 0.0f;   // [-1, 1], right

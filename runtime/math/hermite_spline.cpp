@@ -93,15 +93,20 @@ float time_at_arc_length(std::span<const HermiteKey> keys, const ArcLengthTable&
     const float t_lo = table.start_time + dt * static_cast<float>(lo);
     const float piece = table.length[lo + 1] - table.length[lo];
     float t = t_lo + (piece > 0.0f ? (distance - table.length[lo]) / piece : 0.0f) * dt;
-    // Newton on f(t) = length(t) − distance, length(t) integrated from the
-    // bracket start with the same Gauss–Legendre rule; stays inside the bracket.
-    for (int iteration = 0; iteration < 2; ++iteration) {
-        const float speed_t = length_of(sample_hermite(keys, t).velocity);
-        if (!(speed_t > 1e-6f)) break;
+    // Safeguarded Newton on f(t) = length(t) − distance, length(t) integrated
+    // from the bracket start with the same Gauss–Legendre rule: each step
+    // narrows [a, b] around the root, and a step that would leave it bisects
+    // instead (where the speed changes sharply inside the bracket, as on a
+    // curve that climbs steeply and then runs flat, plain Newton overshoots).
+    float a = t_lo, b = t_lo + dt;
+    for (int iteration = 0; iteration < 3; ++iteration) {
         const float covered = table.length[lo] + gauss_length(keys, t_lo, t);
-        t -= (covered - distance) / speed_t;
-        if (t < t_lo) t = t_lo;
-        if (t > t_lo + dt) t = t_lo + dt;
+        if (covered < distance) a = t;
+        else b = t;
+        const float speed_t = length_of(sample_hermite(keys, t).velocity);
+        float next = speed_t > 1e-6f ? t - (covered - distance) / speed_t : 0.5f * (a + b);
+        if (!(next >= a && next <= b)) next = 0.5f * (a + b);
+        t = next;
     }
     return t;
 }

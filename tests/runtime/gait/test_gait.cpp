@@ -219,15 +219,27 @@ TEST_CASE("stopping mid-step plants the swing foot quickly and nothing teleports
     }
 }
 
-TEST_CASE("slopes reduce the speed by the configured factor per degree", "[gait]") {
-    SimConfig c;
-    Terrain hill;
+TEST_CASE("slopes reduce the speed by the configured factor per degree, and climbing is capped at 0.6 m/s", "[gait]") {
     const float grade = static_cast<float>(std::tan(15.0 * det::kDegToRad));
+    Terrain hill;
     hill.slopes.push_back({-5.0f, -40.0f, 5.0f, -1.0f, 39.0f * grade, 0.0f, -grade});  // rises toward −Z
-    Simulation sim(c, hill);
-    run_ticks(sim, stick(0.0, 1.0), 240 * 4);
-    CHECK(sim.state().root_position.z < -3.0f);
-    CHECK(sim.state().gait.speed == Approx(c.max_speed * (1.0f - c.slope_speed_factor * 15.0f)).epsilon(1e-3));
+    {
+        // 15° at a walk: the slope factor alone (0.85 × 1.5 m/s climbs 0.33 m/s).
+        SimConfig c;
+        c.max_speed = 1.5f;
+        Simulation sim(c, hill);
+        run_ticks(sim, stick(0.0, 1.0), 240 * 4);
+        CHECK(sim.state().root_position.z < -3.0f);
+        CHECK(sim.state().gait.speed == Approx(c.max_speed * (1.0f - c.slope_speed_factor * 15.0f)).epsilon(1e-3));
+    }
+    {
+        // At a full run 0.85 × 3 m/s would climb 0.68 m/s: capped at 0.6 m/s of climb.
+        SimConfig c;
+        Simulation sim(c, hill);
+        run_ticks(sim, stick(0.0, 1.0), 240 * 4);
+        CHECK(sim.state().root_position.z < -3.0f);
+        CHECK(sim.state().gait.speed == Approx(0.6f / grade).epsilon(1e-3));
+    }
 }
 
 TEST_CASE("the swing foot clears a 20 cm step up and down", "[gait]") {
