@@ -15,8 +15,8 @@ for program in stand_still walk_stop circle demo slow_walk fast_walk run start_s
 done
 # The motion-graph goldens (tests/app/test_replay_golden.cpp, [golden_graph]):
 # written by the test itself, with the default graph's hash they belong to.
-cmake --build --preset release --target marionette_app_tests
-(cd "$tmp" && MARIONETTE_WRITE_GOLDEN=1 "$OLDPWD/build/release/tests/marionette_app_tests" "[golden_graph]" >/dev/null)
+cmake --build --preset release --target marionette_golden_tests
+(cd "$tmp" && MARIONETTE_WRITE_GOLDEN=1 "$OLDPWD/build/release/tests/marionette_golden_tests" "[golden_graph]" >/dev/null)
 for name in graph_actions graph_feet_circle_stairs graph_switch_stairs; do
   cp "$tmp/golden_$name.csv" "tests/golden/$name.trace.csv"
 done
