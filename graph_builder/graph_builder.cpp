@@ -126,7 +126,7 @@ constexpr int kMaxBridgeRounds = 64;  // rounds of adding bridges before the bui
 std::int64_t search_transitions(const FrameFeatures& features, const GraphBuildParams& params, const GraphBuildHooks& hooks,
                                 GraphBuildOutput& out) {
     const std::vector<double> percentiles =
-        distance_percentiles(features, {params.threshold_percentile, params.bridge_percentile});
+        distance_percentiles(features, {params.threshold_percentile, params.bridge_percentile}, 65536, params.threads);
     out.threshold = params.threshold_absolute > 0.0 ? params.threshold_absolute : percentiles[0];
     out.bridge_threshold = std::max(out.threshold, percentiles[1]);
 
@@ -192,13 +192,14 @@ std::vector<PlacedTransition> place_candidates(const ClipDatabase& db, const std
     }
     const unsigned threads =
         std::max(1u, params.threads > 0 ? static_cast<unsigned>(params.threads) : std::thread::hardware_concurrency());
-    std::vector<std::thread> workers;
-    for (unsigned w = 0; w < threads; ++w)
-        workers.emplace_back([&, w] {
-            for (size_t c = w; c < placed.size(); c += threads)
-                reference_pair_distance(db, positions, params.window_frames, leg, placed[c].candidate.from_frame,
-                                        placed[c].candidate.to_frame, &placed[c].align);
-        });
+    const auto work = [&](unsigned w) {
+        for (size_t c = w; c < placed.size(); c += threads)
+            reference_pair_distance(db, positions, params.window_frames, leg, placed[c].candidate.from_frame,
+                                    placed[c].candidate.to_frame, &placed[c].align);
+    };
+    std::vector<std::thread> workers;  // the calling thread is worker 0
+    for (unsigned w = 1; w < threads; ++w) workers.emplace_back(work, w);
+    work(0);
     for (std::thread& t : workers) t.join();
     return placed;
 }

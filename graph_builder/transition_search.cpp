@@ -224,7 +224,7 @@ double reference_pair_distance(const ClipDatabase& db, std::span<const vec3> pos
 }
 
 std::vector<double> distance_percentiles(const FrameFeatures& f, const std::vector<double>& percentiles,
-                                         std::int64_t max_samples) {
+                                         std::int64_t max_samples, int thread_request) {
     // (The sample size: the percentile of 65 536 pairs is within a fraction of a percent.)
     std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
     std::int64_t starts = 0, ends = 0;
@@ -249,13 +249,17 @@ std::vector<double> distance_percentiles(const FrameFeatures& f, const std::vect
     }
     if (pairs.empty()) return std::vector<double>(percentiles.size(), 0.0);
     std::vector<double> d(pairs.size());
-    const int threads = thread_count(0);
+    const int threads = thread_count(thread_request);
+    const auto work = [&](int t) {
+        for (size_t p = static_cast<size_t>(t); p < pairs.size(); p += static_cast<size_t>(threads))
+            d[p] = feature_pair_distance(f, pairs[p].first, pairs[p].second);
+    };
+    // The calling thread is worker 0: one thread starts no other (no thread is
+    // created at all, which also keeps qemu user-mode emulation out of glibc's
+    // thread-stack cache, where the aarch64 check was seen to spin).
     std::vector<std::thread> workers;
-    for (int t = 0; t < threads; ++t)
-        workers.emplace_back([&, t] {
-            for (size_t p = static_cast<size_t>(t); p < pairs.size(); p += static_cast<size_t>(threads))
-                d[p] = feature_pair_distance(f, pairs[p].first, pairs[p].second);
-        });
+    for (int t = 1; t < threads; ++t) workers.emplace_back(work, t);
+    work(0);
     for (std::thread& w : workers) w.join();
     std::sort(d.begin(), d.end());
     std::vector<double> out;

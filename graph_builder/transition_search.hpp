@@ -121,7 +121,8 @@ std::vector<std::pair<std::int32_t, std::int32_t>> local_minima(std::span<const 
 
 // Distance at a percentile (0–100) of all valid pairs: exact when there are at
 // most `max_samples` pairs, else over a deterministic sample of that many.
+// `threads` (0: all cores) only shares the work: the result is the same.
 std::vector<double> distance_percentiles(const FrameFeatures& features, const std::vector<double>& percentiles,
-                                         std::int64_t max_samples = 65536);
+                                         std::int64_t max_samples = 65536, int threads = 0);
 
 }  // namespace marionette::offline

@@ -47,6 +47,10 @@ ctest --preset tsan -R '^stress:' -j 1
 # (a plain Release build) and Clang 14, each compiling the deterministic core only.
 echo "== determinism: goldens under other compilers and optimisation levels"
 bash scripts/check-builds.sh
+# The same goldens cross-built for aarch64 and run under qemu user-mode emulation
+# (installs the cross toolchain and the :arm64 packages when missing).
+echo "== determinism: aarch64 under qemu"
+bash scripts/check-aarch64.sh
 # Fuzz regression gate (issue 18): every libFuzzer target of tests/fuzz for 30 s
 # on its seed corpus and kept reproducers; any crash, UB, leak, timeout or huge
 # allocation fails. Builds only the fuzz targets (the `fuzz` preset, clang 14).

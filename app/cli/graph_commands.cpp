@@ -185,7 +185,7 @@ int graph_default_build_command(const GraphBuildCommandOptions& o) {
     const AppConfig config = load_config(o.config_file);
     offline::GraphBuildHooks hooks;
     if (!o.plot_file.empty()) hooks.plot_size = 1024;
-    const DefaultGraphBuild build = build_default_motion_graph_report(config.sim, config.graph_build, hooks);
+    const DefaultGraphBuild build = build_default_motion_graph_report(config.sim, config.graph_build, hooks, o.threads);
     const offline::GraphBuildOutput& out = build.output;
     const MotionGraph& g = out.graph;
     write_binary_file(o.output_file, serialize_motion_graph(g));

@@ -123,9 +123,10 @@ std::vector<Clip> generate_locomotion_clips(const SimConfig& config, double rate
 }
 
 DefaultGraphBuild build_default_motion_graph_report(const SimConfig& config, const GraphBuildConfig& build_config,
-                                                    const offline::GraphBuildHooks& hooks) {
+                                                    const offline::GraphBuildHooks& hooks, int threads) {
     const auto started = std::chrono::steady_clock::now();
-    const offline::GraphBuildParams params = graph_build_params(build_config);
+    offline::GraphBuildParams params = graph_build_params(build_config);
+    params.threads = threads;
     std::vector<Clip> clips = generate_locomotion_clips(config, params.analysis_rate_hz);
     for (Clip& c : default_action_clips()) clips.push_back(std::move(c));
     std::vector<std::string> names;
@@ -154,8 +155,8 @@ DefaultGraphBuild build_default_motion_graph_report(const SimConfig& config, con
     return build;
 }
 
-MotionGraph build_default_motion_graph(const SimConfig& config, const GraphBuildConfig& build_config) {
-    return std::move(build_default_motion_graph_report(config, build_config).output.graph);
+MotionGraph build_default_motion_graph(const SimConfig& config, const GraphBuildConfig& build_config, int threads) {
+    return std::move(build_default_motion_graph_report(config, build_config, {}, threads).output.graph);
 }
 
 }  // namespace marionette

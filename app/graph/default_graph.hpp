@@ -39,9 +39,11 @@ struct DefaultGraphBuild {
 // parameters `build_config` → pruned graph. The graph's build_seconds
 // stays 0 so its serialized bytes depend only on the inputs. Throws
 // std::runtime_error naming the label and why when a required label is cut off.
-// `hooks` as for offline::build_motion_graph (progress, plot size).
+// `hooks` as for offline::build_motion_graph (progress, plot size). `threads`:
+// the builder's worker threads (0: all cores; 1 starts no thread); the bytes are
+// the same for any count.
 DefaultGraphBuild build_default_motion_graph_report(const SimConfig& config, const GraphBuildConfig& build_config,
-                                                    const offline::GraphBuildHooks& hooks = {});
-MotionGraph build_default_motion_graph(const SimConfig& config, const GraphBuildConfig& build_config);
+                                                    const offline::GraphBuildHooks& hooks = {}, int threads = 0);
+MotionGraph build_default_motion_graph(const SimConfig& config, const GraphBuildConfig& build_config, int threads = 0);
 
 }  // namespace marionette
