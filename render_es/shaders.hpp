@@ -76,9 +76,11 @@ void main() {
     vec2 grid = abs(fract(v_world.xz + 0.5) - 0.5) / max(fwidth(v_world.xz), vec2(1e-4));
     float line = 1.0 - 0.25 * (1.0 - clamp(min(grid.x, grid.y), 0.0, 1.0));
     float flat_face = step(0.5, n.y);
-    // Checker and grid on the ground only: boxes and slopes stay plain so their
-    // faces (lit differently by the sun) make each step's edge read.
-    base *= mix(1.0, checker * line, flat_face * step(float(v_part), 0.5));
+    // Checker and grid on the ground and on slope tops (a wide hillside is
+    // otherwise one flat colour and motion across it does not read); boxes stay
+    // plain so their faces (lit differently by the sun) make each step's edge read.
+    float textured = v_part == 1 ? 0.0 : 1.0;
+    base *= mix(1.0, checker * line, flat_face * textured);
     float diffuse = max(dot(n, u_sun), 0.0);
     float sky = 0.5 + 0.5 * n.y;
     vec3 lit = base * (0.25 + 0.25 * sky + 0.6 * diffuse);
