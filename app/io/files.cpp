@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -86,6 +87,15 @@ void InputLogFile::close() {
     const int rc = std::fclose(file_);
     file_ = nullptr;
     if (rc != 0) throw std::runtime_error(path_ + ": close failed: " + std::strerror(errno));
+}
+
+std::string local_date_time_stamp() {
+    const std::time_t now = std::time(nullptr);
+    std::tm local{};
+    localtime_r(&now, &local);
+    char stamp[32];
+    std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &local);
+    return stamp;
 }
 
 }  // namespace marionette

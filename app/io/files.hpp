@@ -20,6 +20,11 @@ void write_text_file(const std::string& path, const std::string& text);
 // PATH.2, ... (continuations holding whole chunks). These list and read them
 // in order, as one log; a lone file is just itself.
 std::vector<std::string> input_log_files(const std::string& path);
+
+// The local date and time as YYYYMMDD-HHMMSS, for naming files only (a
+// recording's name). Calendar time never paces anything: the live pipeline
+// reads only CLOCK_MONOTONIC (tests/app/faults, the clock-jump test).
+std::string local_date_time_stamp();
 std::vector<std::uint8_t> read_input_log_bytes(const std::string& path);
 
 class InputLogFile {

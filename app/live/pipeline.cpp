@@ -736,10 +736,18 @@ public:
         TickRecord record;
         for (;;) {
             const bool finished = sh_.simulation_done.load(std::memory_order_acquire);
-            while (sh_.records.try_pop(record)) writer_.handle(record);
+            // At most one ring's worth per pass: a --fast simulation refills the
+            // ring as fast as it is drained, and an unbounded drain never got to
+            // the config watcher below, so live edits applied late or never.
+            std::size_t drained = 0;
+            while (drained < kRecordRingCapacity && sh_.records.try_pop(record)) {
+                writer_.handle(record);
+                ++drained;
+            }
+            const bool emptied = drained < kRecordRingCapacity;
             const std::int64_t now = monotonic_ns();
             writer_.flush_by_clock(now);
-            if (finished) break;  // simulation_done was read before the last drain
+            if (finished && emptied) break;  // simulation_done was read before the last drain
             if (stop_seen_ < 0 && o_.stop_request && o_.stop_request->load()) {
                 stop_seen_ = now;
                 result_.stopped = true;
@@ -753,7 +761,8 @@ public:
             notifier_.poll(now, sh_.counters.simulation_heartbeat.load(std::memory_order_relaxed),
                            sh_.counters.frames.load(std::memory_order_relaxed));
             const bool hurry = o_.virtual_time || sh_.stop.load(std::memory_order_relaxed);
-            tuning_.wait_and_poll(sh_, o_.err, hurry ? kWriterPollShortMs : kWriterPollMs);
+            // Still behind: look at the watcher without waiting, then drain on.
+            tuning_.wait_and_poll(sh_, o_.err, !emptied ? 0 : hurry ? kWriterPollShortMs : kWriterPollMs);
         }
     }
 

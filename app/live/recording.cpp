@@ -94,11 +94,7 @@ std::string new_recording_path(const std::string& dir) {
     fs::create_directories(dir, ec);
     if (ec || !fs::is_directory(dir, ec))
         throw std::runtime_error(dir + ": cannot create the recordings directory: " + (ec ? ec.message() : "not a directory"));
-    const std::time_t now = std::time(nullptr);
-    std::tm local{};
-    localtime_r(&now, &local);
-    char stamp[32];
-    std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &local);
+    const std::string stamp = local_date_time_stamp();
     for (int n = 1;; ++n) {
         const std::string path = fmt::format("{}/run-{}{}.mlog", dir, stamp, n == 1 ? "" : fmt::format("-{}", n));
         if (!fs::exists(path, ec)) return path;

@@ -244,8 +244,12 @@ TEST_CASE("default graph: every face button plays its action while walking and s
             std::uint32_t mask = 0;
             for (const std::string& l : locomotion) mask |= 1u << graph->label_index(l);
             CHECK((graph->clips[static_cast<size_t>(after)].label_mask & mask) != 0u);
-            // No joint jumps: 2 cm in a 240 Hz tick is 4.8 m/s, faster than the jump's arm swing.
-            CHECK(run.max_joint_move_m < 0.02);
+            // No joint jumps: 2.5 cm in a 240 Hz tick is 6 m/s, about the peak speed of
+            // a running swing foot (twice the body's). Since the swing path lifts
+            // straight up and sets straight down (docs/gait.md, "Swing path"), the
+            // captured run's swing foot peaks at 4.9 m/s (2.03 cm a tick) in the
+            // locomotion before every action; a pop would be several times that.
+            CHECK(run.max_joint_move_m < 0.025);
             // Deterministic: a second run gives the same hash every tick.
             if (button == 0) CHECK(run_action(graph, button, label, stick_y).hashes == run.hashes);
         }
