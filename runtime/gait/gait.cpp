@@ -243,19 +243,28 @@ constexpr float kLiftOffClearanceM = 0.005f;  // m: the straight lift-off and se
 // them: the path rises before a step up and comes down only past a step edge.
 void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, const GaitConfig& c, float blend) {
     constexpr int n = kSwingPathKeys;
-    // The toes at a key point between their directions at the neighbouring keys.
-    std::array<vec3, n> toe_direction{};
-    for (int i = 0; i < n; ++i)
-        toe_direction[static_cast<std::size_t>(i)] = quat_rotate(swing_rotation(f, key_reach(i)), vec3(0.0f, 0.0f, 1.0f));
+    // The foot at a key turns between its rotations at the neighbouring keys.
+    std::array<quat, n> rotation{};
+    for (int i = 0; i < n; ++i) rotation[static_cast<std::size_t>(i)] = swing_rotation(f, key_reach(i));
+    const std::array<vec3, 3> sole = sole_offsets(rig);
     std::array<float, n> ground{};
     for (int i = 0; i < n; ++i) {
         const vec3 a = lerp(f.start, f.target, key_reach(i));
         float h = query_ground(terrain, a.x, a.z).height;
-        const vec3 toes[3] = {toe_direction[static_cast<std::size_t>(i > 0 ? i - 1 : 0)], toe_direction[static_cast<std::size_t>(i)],
-                              toe_direction[static_cast<std::size_t>(i + 1 < n ? i + 1 : n - 1)]};
-        for (const vec3& forward : toes)
+        const quat turns[3] = {rotation[static_cast<std::size_t>(i > 0 ? i - 1 : 0)], rotation[static_cast<std::size_t>(i)],
+                               rotation[static_cast<std::size_t>(i + 1 < n ? i + 1 : n - 1)]};
+        for (const quat& q : turns) {
+            const vec3 forward = quat_rotate(q, vec3(0.0f, 0.0f, 1.0f));
             for (float r : {rig.foot_length, rig.foot_length + rig.toe_length})
                 h = maxf(h, query_ground(terrain, a.x + forward.x * r, a.z + forward.z * r).height);
+            // A foot pitched toes-down (landing on a ramp below it) carries its
+            // ball and toe tip below the sole under the ankle: the ankle must
+            // clear the ground under them by that much more.
+            for (const vec3& o : sole) {
+                const vec3 p = quat_rotate(q, o);
+                h = maxf(h, query_ground(terrain, a.x + p.x, a.z + p.z).height - p.y - rig.ankle_height);
+            }
+        }
         ground[static_cast<std::size_t>(i)] = h;
     }
     // The prototype's lift against the fraction of the step it has covered:
