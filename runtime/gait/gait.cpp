@@ -718,9 +718,15 @@ Placement aim_swing(const GaitState& g, const GaitTick& t, vec3 root, int i, flo
     const double turn = det::wrap_angle(static_cast<double>(t.desired_heading) - t.heading);
     // Small steps: a foot turns at most kMaxTurnPerStepDeg per swing.
     const double max_turn = minf(minf(t.c.turn_rate_deg_s, kMaxFootTurnDegS) * time_to_land, kMaxTurnPerStepDeg) * det::kDegToRad;
-    const HeadingFrame then = heading_frame(t.heading + clamp_magnitude(turn, max_turn));
+    const double heading_then = t.heading + clamp_magnitude(turn, max_turn);
+    const HeadingFrame then = heading_frame(heading_then);
     const vec3 spot = root + then.left * (side_sign(i) * t.rig.hip_half_width);
-    return place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, then.forward);
+    // The foot turns that far from its own facing, not from the root's: a foot
+    // still facing behind the turned root would otherwise turn up to 180° in one swing.
+    const vec3 toes = quat_rotate(g.feet[static_cast<std::size_t>(i)].rotation, vec3(0.0f, 0.0f, 1.0f));
+    const double yaw = det::atan2(toes.x, toes.z);
+    const double facing = yaw + clamp_magnitude(det::wrap_angle(heading_then - yaw), max_turn);
+    return place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, heading_frame(facing).forward);
 }
 
 // A swing re-aims (up to kMaxReaims times, early in the swing) when the stick changed the landing spot a lot.
