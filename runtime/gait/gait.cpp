@@ -571,6 +571,7 @@ constexpr float kMinHipDropShareSq = 0.09f;        // the hip stays at least 0.3
 constexpr float kMidSwingBump = 4.0f;              // 4·u·(1 − u): 0 at lift-off and landing, 1 mid-swing
 constexpr float kEarlyLiftPhase = 0.05f;          // … at most this much of a cycle before its duty factor
 constexpr float kEarlyLiftReachShare = 0.9f;      // a planted foot this share of the leg reach behind its hip lifts
+constexpr float kEarlyLiftStanceShare = 0.95f;    // … or this share of kStanceReachM (before the root pivots on it)
 constexpr float kNoLimitM = 1e9f;                  // m: a pelvis height limit that no foot imposes
 
 // The stick's command this tick.
@@ -776,11 +777,13 @@ void lift_if_due(GaitState& g, const GaitTick& t, vec3 root, int i) {
     const float psi = foot_phase(g.cycle_phase, i);
     const bool walking = !running(t.c, g.speed);
     // A foot left far behind its hip (a start down a slope, a long first
-    // stride) lifts early, while the other is planted, instead of being dragged
-    // out of the leg's reach.
+    // stride, the ground easing so the root speeds up past the planned stance)
+    // lifts early, while the other is planted, instead of being dragged out of
+    // the leg's reach or, nearer, holding the root back (keep_stance_in_reach).
     const vec3 hip = root + t.h.left * (side_sign(i) * t.rig.hip_half_width);
+    const float behind = dot3(hip - f.ankle, t.h.forward);
     const bool left_behind = !other.swinging && psi >= t.plan.duty - kEarlyLiftPhase &&
-                             dot3(hip - f.ankle, t.h.forward) > kEarlyLiftReachShare * t.rig.leg_reach;
+                             (behind > kEarlyLiftReachShare * t.rig.leg_reach || behind > kEarlyLiftStanceShare * kStanceReachM);
     if ((psi >= t.plan.duty && (!walking || !other.swinging)) || left_behind) {
         begin_swing(f, aim_swing(g, t, root, i, psi), t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
         f.planned_speed = g.commanded_speed;
