@@ -243,19 +243,28 @@ constexpr float kLiftOffClearanceM = 0.005f;  // m: the straight lift-off and se
 // them: the path rises before a step up and comes down only past a step edge.
 void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, const GaitConfig& c, float blend) {
     constexpr int n = kSwingPathKeys;
-    // The toes at a key point between their directions at the neighbouring keys.
-    std::array<vec3, n> toe_direction{};
-    for (int i = 0; i < n; ++i)
-        toe_direction[static_cast<std::size_t>(i)] = quat_rotate(swing_rotation(f, key_reach(i)), vec3(0.0f, 0.0f, 1.0f));
+    // The foot at a key turns between its rotations at the neighbouring keys.
+    std::array<quat, n> rotation{};
+    for (int i = 0; i < n; ++i) rotation[static_cast<std::size_t>(i)] = swing_rotation(f, key_reach(i));
+    const std::array<vec3, 3> sole = sole_offsets(rig);
     std::array<float, n> ground{};
     for (int i = 0; i < n; ++i) {
         const vec3 a = lerp(f.start, f.target, key_reach(i));
         float h = query_ground(terrain, a.x, a.z).height;
-        const vec3 toes[3] = {toe_direction[static_cast<std::size_t>(i > 0 ? i - 1 : 0)], toe_direction[static_cast<std::size_t>(i)],
-                              toe_direction[static_cast<std::size_t>(i + 1 < n ? i + 1 : n - 1)]};
-        for (const vec3& forward : toes)
+        const quat turns[3] = {rotation[static_cast<std::size_t>(i > 0 ? i - 1 : 0)], rotation[static_cast<std::size_t>(i)],
+                               rotation[static_cast<std::size_t>(i + 1 < n ? i + 1 : n - 1)]};
+        for (const quat& q : turns) {
+            const vec3 forward = quat_rotate(q, vec3(0.0f, 0.0f, 1.0f));
             for (float r : {rig.foot_length, rig.foot_length + rig.toe_length})
                 h = maxf(h, query_ground(terrain, a.x + forward.x * r, a.z + forward.z * r).height);
+            // A foot pitched toes-down (landing on a ramp below it) carries its
+            // ball and toe tip below the sole under the ankle: the ankle must
+            // clear the ground under them by that much more.
+            for (const vec3& o : sole) {
+                const vec3 p = quat_rotate(q, o);
+                h = maxf(h, query_ground(terrain, a.x + p.x, a.z + p.z).height - p.y - rig.ankle_height);
+            }
+        }
         ground[static_cast<std::size_t>(i)] = h;
     }
     // The prototype's lift against the fraction of the step it has covered:
@@ -562,6 +571,7 @@ constexpr float kMinHipDropShareSq = 0.09f;        // the hip stays at least 0.3
 constexpr float kMidSwingBump = 4.0f;              // 4·u·(1 − u): 0 at lift-off and landing, 1 mid-swing
 constexpr float kEarlyLiftPhase = 0.05f;          // … at most this much of a cycle before its duty factor
 constexpr float kEarlyLiftReachShare = 0.9f;      // a planted foot this share of the leg reach behind its hip lifts
+constexpr float kEarlyLiftStanceShare = 0.95f;    // … or this share of kStanceReachM (before the root pivots on it)
 constexpr float kNoLimitM = 1e9f;                  // m: a pelvis height limit that no foot imposes
 
 // The stick's command this tick.
@@ -709,9 +719,15 @@ Placement aim_swing(const GaitState& g, const GaitTick& t, vec3 root, int i, flo
     const double turn = det::wrap_angle(static_cast<double>(t.desired_heading) - t.heading);
     // Small steps: a foot turns at most kMaxTurnPerStepDeg per swing.
     const double max_turn = minf(minf(t.c.turn_rate_deg_s, kMaxFootTurnDegS) * time_to_land, kMaxTurnPerStepDeg) * det::kDegToRad;
-    const HeadingFrame then = heading_frame(t.heading + clamp_magnitude(turn, max_turn));
+    const double heading_then = t.heading + clamp_magnitude(turn, max_turn);
+    const HeadingFrame then = heading_frame(heading_then);
     const vec3 spot = root + then.left * (side_sign(i) * t.rig.hip_half_width);
-    return place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, then.forward);
+    // The foot turns that far from its own facing, not from the root's: a foot
+    // still facing behind the turned root would otherwise turn up to 180° in one swing.
+    const vec3 toes = quat_rotate(g.feet[static_cast<std::size_t>(i)].rotation, vec3(0.0f, 0.0f, 1.0f));
+    const double yaw = det::atan2(toes.x, toes.z);
+    const double facing = yaw + clamp_magnitude(det::wrap_angle(heading_then - yaw), max_turn);
+    return place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, heading_frame(facing).forward);
 }
 
 // A swing re-aims (up to kMaxReaims times, early in the swing) when the stick changed the landing spot a lot.
@@ -761,11 +777,13 @@ void lift_if_due(GaitState& g, const GaitTick& t, vec3 root, int i) {
     const float psi = foot_phase(g.cycle_phase, i);
     const bool walking = !running(t.c, g.speed);
     // A foot left far behind its hip (a start down a slope, a long first
-    // stride) lifts early, while the other is planted, instead of being dragged
-    // out of the leg's reach.
+    // stride, the ground easing so the root speeds up past the planned stance)
+    // lifts early, while the other is planted, instead of being dragged out of
+    // the leg's reach or, nearer, holding the root back (keep_stance_in_reach).
     const vec3 hip = root + t.h.left * (side_sign(i) * t.rig.hip_half_width);
+    const float behind = dot3(hip - f.ankle, t.h.forward);
     const bool left_behind = !other.swinging && psi >= t.plan.duty - kEarlyLiftPhase &&
-                             dot3(hip - f.ankle, t.h.forward) > kEarlyLiftReachShare * t.rig.leg_reach;
+                             (behind > kEarlyLiftReachShare * t.rig.leg_reach || behind > kEarlyLiftStanceShare * kStanceReachM);
     if ((psi >= t.plan.duty && (!walking || !other.swinging)) || left_behind) {
         begin_swing(f, aim_swing(g, t, root, i, psi), t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
         f.planned_speed = g.commanded_speed;
