@@ -35,6 +35,7 @@ public:
         return lo + static_cast<int>(next() % static_cast<std::uint64_t>(hi - lo + 1));
     }
     bool chance(double p) { return uniform() < p; }
+    bool coin() { return (next() & 1u) != 0; }  // one bit: a fair coin
 
 private:
     std::uint64_t state_;

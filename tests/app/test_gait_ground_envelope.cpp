@@ -19,29 +19,15 @@
 
 #include "app/config/config.hpp"
 #include "app/eval/gait_eval.hpp"
+#include "app/eval/gait_sweep.hpp"
 #include "runtime/formats/stick_program.hpp"
 
 using namespace marionette;
 
 namespace {
 
-// SplitMix64: a small, portable generator, so a seed gives the same case everywhere.
-class Rng {
-public:
-    explicit Rng(std::uint64_t seed) : state_(seed) {}
-    std::uint64_t next() {
-        std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    }
-    double uniform(double lo, double hi) { return lo + (hi - lo) * static_cast<double>(next() >> 11) * 0x1.0p-53; }
-    int integer(int lo, int hi) { return lo + static_cast<int>(next() % static_cast<std::uint64_t>(hi - lo + 1)); }
-    bool coin() { return (next() & 1u) != 0; }
-
-private:
-    std::uint64_t state_;
-};
+// The sweep's SplitMix64 (app/eval/gait_sweep.hpp): a seed gives the same case everywhere.
+using Rng = SweepRandom;
 
 enum class Ground { stairs, slope, heightfield, curb };
 
