@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <limits>
 #include <map>
@@ -297,7 +298,7 @@ void row_dots(const double* a, std::int32_t a_first, std::int32_t a_rows, const 
 enum WindowSum { kSumDot, kSumCross, kSumY, kSumCentroidDot, kSumCentroidCross, kSumCount };
 
 struct TileTerms {
-    const double* dot;   // [nr][nc] per-frame cross terms (dgemm)
+    const double* dot;   // per-frame cross terms (dgemm), row r at row_at(r): a ring of `ring` rows of nc
     const double* cross;
     const double* y;
     const double* row_cx;  // frame centroids of the tile's rows (nr) and columns (nc)
@@ -305,6 +306,8 @@ struct TileTerms {
     const double* col_cx;
     const double* col_cz;
     size_t nc;
+    size_t ring;
+    size_t row_at(size_t r) const { return (r % ring) * nc; }
 };
 
 // Row r's sums from row r − 1's: pair (r, c)'s k-frame diagonal is pair
@@ -313,8 +316,8 @@ struct TileTerms {
 // (the products are doubles: sliding along 500 diagonal steps costs ~1e-13). Columns c ≥ 1 only.
 MARIONETTE_VECTOR_CLONES void slide_window_sums(const TileTerms& m, std::int32_t r, std::int32_t k, std::int32_t dc,
                                                 const double* __restrict prev, double* __restrict cur) {
-    const size_t in = static_cast<size_t>(r + k - 1) * m.nc + static_cast<size_t>(k - 1);
-    const size_t out = static_cast<size_t>(r - 1) * m.nc;
+    const size_t in = m.row_at(static_cast<size_t>(r + k - 1)) + static_cast<size_t>(k - 1);
+    const size_t out = m.row_at(static_cast<size_t>(r - 1));
     const size_t n = static_cast<size_t>(dc);
     const double* __restrict dot_in = m.dot + in;
     const double* __restrict dot_out = m.dot + out;
@@ -344,7 +347,7 @@ void direct_window_sums(const TileTerms& m, std::int32_t r, std::int32_t c, std:
     double s[kSumCount] = {};
     for (std::int32_t t = 0; t < k; ++t) {
         const size_t a = static_cast<size_t>(r + t), b = static_cast<size_t>(c + t);
-        const size_t at = a * m.nc + b;
+        const size_t at = m.row_at(a) + b;
         s[kSumDot] += m.dot[at];
         s[kSumCross] += m.cross[at];
         s[kSumY] += m.y[at];
@@ -402,7 +405,9 @@ struct TileScratch {
     std::vector<double> sums[2];          // window sums of the previous and the current row
     std::vector<double> col_spread, col_x, col_z;  // per column's window B
     std::vector<std::int32_t> invalid_cols;
-    ScratchArray<float> d, hi;            // lower and upper bounds of the distances of the tile plus halo
+    ScratchArray<float> box_lo, box_hi;   // lower and upper bounds of the distances of a computed box
+    ScratchArray<float> d;                // the lower bounds of a tile read transposed from the box
+    std::vector<std::uint8_t> mask;       // a tile row's cells that may be kept
     std::vector<std::pair<int, int>> undecided;  // neighbours whose order against a cell needs the exact kernel
     std::vector<TransitionCandidate> found;
     std::vector<float> plot;
@@ -430,6 +435,11 @@ void perturb_products(double* c, std::int32_t row0, std::int32_t nr, std::int32_
 struct TileSpan {
     std::int32_t ci0, ci1, cj0, cj1;  // the cells this tile decides
     std::int32_t ei0, ei1, ej0, ej1;  // the cells it holds (plus the halo)
+    const float* lo = nullptr;        // the held cells' lower bounds, (ei0, ej0) first, rows `stride` apart
+    size_t stride = 0;
+    const float* hi = nullptr;        // their upper bounds, (ei0, ej0) first, i and j steps apart
+    size_t hi_i_step = 0, hi_j_step = 1;
+    bool empty() const { return ci0 >= ci1 || cj0 >= cj1; }
 };
 
 // The fixed-order kernel's float for a valid pair, checked against the interval the
@@ -441,6 +451,59 @@ float exact_distance(const FrameFeatures& f, std::int32_t i, std::int32_t j, flo
     return x;
 }
 
+using BridgeLists = std::map<std::pair<std::int32_t, std::int32_t>, std::vector<TransitionCandidate>>;
+
+// A tile's bounds, read with the halo's edges: outside the held cells, absent.
+struct TileView {
+    const TileSpan& t;
+    float lo(std::int32_t i, std::int32_t j) const {
+        return i < t.ei0 || i >= t.ei1 || j < t.ej0 || j >= t.ej1 ? kPairInvalid : t.lo[at(i, j)];
+    }
+    float hi(std::int32_t i, std::int32_t j) const {
+        return i < t.ei0 || i >= t.ei1 || j < t.ej0 || j >= t.ej1
+                   ? kPairInvalid
+                   : t.hi[static_cast<size_t>(i - t.ei0) * t.hi_i_step + static_cast<size_t>(j - t.ej0) * t.hi_j_step];
+    }
+    size_t at(std::int32_t i, std::int32_t j) const {
+        return static_cast<size_t>(i - t.ei0) * t.stride + static_cast<size_t>(j - t.ej0);
+    }
+};
+
+// Cell (i, j), whose lower bound is at most the keep threshold: a local minimum of the
+// exact matrix? Then kept as a candidate (at most the threshold) or a bridge.
+void decide_cell(const FrameFeatures& f, const CandidateSearchOptions& o, const TileView& m, std::int32_t i,
+                 std::int32_t j, double keep_below, BridgeLists& bridges, TileScratch& s) {
+    const std::int32_t h = o.neighbourhood;
+    const float lo = m.lo(i, j), hi = m.hi(i, j);
+    // Most cells below the threshold lie on a valley's slope: a surely smaller
+    // (or excluded) direct neighbour rejects them before the full neighbourhood.
+    if (m.hi(i, j - 1) < lo || m.hi(i, j + 1) < lo || m.hi(i - 1, j) < lo || m.hi(i + 1, j) < lo) return;
+    if (m.hi(i - 1, j - 1) < lo || m.hi(i + 1, j + 1) < lo || m.hi(i - 1, j + 1) < lo || m.hi(i + 1, j - 1) < lo) return;
+    s.undecided.clear();
+    for (int di = -h; di <= h; ++di)
+        for (int dj = -h; dj <= h; ++dj) {
+            if (di == 0 && dj == 0) continue;
+            if (m.hi(i + di, j + dj) < lo) return;  // surely smaller, or excluded (−1)
+            if (m.lo(i + di, j + dj) <= hi) s.undecided.push_back({di, dj});  // else surely larger, or absent
+        }
+    const float v = exact_distance(f, i, j, lo, hi, s);
+    if (static_cast<double>(v) > keep_below) return;
+    for (const auto& [di, dj] : s.undecided) {
+        const float ulo = m.lo(i + di, j + dj), uhi = m.hi(i + di, j + dj);
+        const float u = ulo == uhi ? ulo : exact_distance(f, i + di, j + dj, ulo, uhi, s);
+        if (u < v || (u == v && (di < 0 || (di == 0 && dj < 0)))) return;
+    }
+    if (v <= o.threshold) {
+        s.found.push_back({i, j, v});
+        return;
+    }
+    auto& best = bridges[{f.clip_of[static_cast<size_t>(i)], f.clip_of[static_cast<size_t>(j)]}];
+    best.push_back({i, j, v});
+    std::sort(best.begin(), best.end(),
+              [](const TransitionCandidate& a, const TransitionCandidate& b) { return a.distance < b.distance; });
+    if (best.size() > static_cast<size_t>(o.bridges_per_clip_pair)) best.pop_back();
+}
+
 // The local minima of the tile's cells, decided on the fixed-order kernel's values.
 // The intervals settle most comparisons: a neighbour whose upper bound is below the
 // cell's lower bound is smaller whatever the rounding, one whose lower bound is above
@@ -448,24 +511,27 @@ float exact_distance(const FrameFeatures& f, std::int32_t i, std::int32_t j, flo
 // interval meets it (and is more than one float wide) are computed exactly. So the
 // result is the local-minimum rule on the exact matrix, cell for cell.
 void decide_tile_minima(const FrameFeatures& f, const CandidateSearchOptions& o, const TileSpan& t, TileScratch& s) {
-    const std::int32_t h = o.neighbourhood, N = f.frames;
-    const size_t udc = static_cast<size_t>(t.ej1 - t.ej0);
-    const auto cell = [&](std::int32_t i, std::int32_t j) -> size_t {
-        return static_cast<size_t>(i - t.ei0) * udc + static_cast<size_t>(j - t.ej0);
-    };
-    const auto lo_at = [&](std::int32_t i, std::int32_t j) -> float {
-        return i < t.ei0 || i >= t.ei1 || j < t.ej0 || j >= t.ej1 ? kPairInvalid : s.d[cell(i, j)];  // outside: absent
-    };
-    const auto hi_at = [&](std::int32_t i, std::int32_t j) -> float {
-        return i < t.ei0 || i >= t.ei1 || j < t.ej0 || j >= t.ej1 ? kPairInvalid : s.hi[cell(i, j)];
-    };
-    std::map<std::pair<std::int32_t, std::int32_t>, std::vector<TransitionCandidate>> bridges;
+    const std::int32_t N = f.frames;
+    const TileView m{t};
+    BridgeLists bridges;
     const double keep_below = std::max(o.threshold, o.bridge_threshold);
+    // The largest float ≤ keep_below: for a float lo, lo ≤ keep_f ⇔ double(lo) ≤ keep_below.
+    float keep_f = static_cast<float>(keep_below);
+    if (static_cast<double>(keep_f) > keep_below) keep_f = std::nextafter(keep_f, -std::numeric_limits<float>::infinity());
+    const std::int32_t first = t.cj0 - t.ej0, width = t.cj1 - t.cj0;
+    s.mask.resize(static_cast<size_t>(width + 8));
+    std::uint8_t* __restrict mask = s.mask.data();
     for (std::int32_t i = t.ci0; i < t.ci1; ++i) {
-        const float* __restrict row = s.d.data() + cell(i, t.ej0);  // row[j − ej0]: lower bounds
-        const float* __restrict row_hi = s.hi.data() + cell(i, t.ej0);
-        std::int64_t evaluated = 0;  // (a separate branch-free loop: it vectorises)
-        for (std::int32_t c = t.cj0 - t.ej0; c < t.cj1 - t.ej0; ++c) evaluated += row[c] >= 0.0f && row[c] < kPairInvalid;
+        const float* __restrict row = t.lo + m.at(i, t.ej0);  // row[j − ej0]: lower bounds
+        // The valid pairs (counted) and the cells that may be kept (0 ≤ lo ≤ keep_below; absent
+        // pairs not), a byte each, in one branch-free loop (`&`, not `&&`: it vectorises); the
+        // marked cells are then visited eight bytes at a time.
+        std::int64_t evaluated = 0;
+        for (std::int32_t c = 0; c < width; ++c) {
+            const float v = row[first + c];
+            evaluated += (v >= 0.0f) & (v < kPairInvalid);
+            mask[c] = static_cast<std::uint8_t>((v >= 0.0f) & (v <= keep_f));
+        }
         s.evaluations += evaluated;
         if (o.plot)  // (the picture shows the lower bounds: it is not part of the graph)
             for (std::int32_t j = t.cj0; j < t.cj1; ++j) {
@@ -476,76 +542,73 @@ void decide_tile_minima(const FrameFeatures& f, const CandidateSearchOptions& o,
                 float& pixel = s.plot[px * static_cast<size_t>(o.plot_size) + py];
                 pixel = std::min(pixel, v);
             }
-        for (std::int32_t j = t.cj0; j < t.cj1; ++j) {
-            const float lo = row[j - t.ej0], hi = row_hi[j - t.ej0];
-            if (!(lo >= 0.0f) || static_cast<double>(lo) > keep_below) continue;  // (also the absent pairs)
-            // Most cells below the threshold lie on a valley's slope: a surely smaller
-            // (or excluded) direct neighbour rejects them before the full neighbourhood.
-            if (hi_at(i, j - 1) < lo || hi_at(i, j + 1) < lo || hi_at(i - 1, j) < lo || hi_at(i + 1, j) < lo) continue;
-            if (hi_at(i - 1, j - 1) < lo || hi_at(i + 1, j + 1) < lo || hi_at(i - 1, j + 1) < lo || hi_at(i + 1, j - 1) < lo)
-                continue;
-            bool minimum = true;
-            s.undecided.clear();
-            for (int di = -h; di <= h && minimum; ++di)
-                for (int dj = -h; dj <= h; ++dj) {
-                    if (di == 0 && dj == 0) continue;
-                    if (hi_at(i + di, j + dj) < lo) {  // surely smaller, or excluded (−1)
-                        minimum = false;
-                        break;
-                    }
-                    if (lo_at(i + di, j + dj) <= hi) s.undecided.push_back({di, dj});  // else surely larger, or absent
-                }
-            if (!minimum) continue;
-            const float v = exact_distance(f, i, j, lo, hi, s);
-            if (static_cast<double>(v) > keep_below) continue;
-            for (const auto& [di, dj] : s.undecided) {
-                const float ulo = lo_at(i + di, j + dj), uhi = hi_at(i + di, j + dj);
-                const float u = ulo == uhi ? ulo : exact_distance(f, i + di, j + dj, ulo, uhi, s);
-                if (u < v || (u == v && (di < 0 || (di == 0 && dj < 0)))) {
-                    minimum = false;
-                    break;
-                }
-            }
-            if (!minimum) continue;
-            if (v <= o.threshold) {
-                s.found.push_back({i, j, v});
-                continue;
-            }
-            auto& best = bridges[{f.clip_of[static_cast<size_t>(i)], f.clip_of[static_cast<size_t>(j)]}];
-            best.push_back({i, j, v});
-            std::sort(best.begin(), best.end(),
-                      [](const TransitionCandidate& a, const TransitionCandidate& b) { return a.distance < b.distance; });
-            if (best.size() > static_cast<size_t>(o.bridges_per_clip_pair)) best.pop_back();
+        for (std::int32_t c = width; c % 8 != 0; ++c) mask[c] = 0;
+        for (std::int32_t word = 0; word < width; word += 8) {
+            std::uint64_t bits;
+            std::memcpy(&bits, mask + word, sizeof bits);
+            if (bits == 0) continue;
+            for (std::int32_t c = word; c < word + 8; ++c)
+                if (mask[c]) decide_cell(f, o, m, i, t.cj0 + c, keep_below, bridges, s);
         }
     }
     for (const auto& [clips, best] : bridges) s.found.insert(s.found.end(), best.begin(), best.end());
 }
 
-void run_tile(const FrameFeatures& f, const CandidateSearchOptions& o, const DistanceErrorBound& bound, std::int32_t i0,
-              std::int32_t i1, std::int32_t j0, std::int32_t j1, TileScratch& s) {
-    const std::int32_t k = f.window, h = o.neighbourhood, N = f.frames;
+// The cells tile [i0, i1) × [j0, j1) decides and the cells it holds (its halo of h).
+TileSpan tile_span(const FrameFeatures& f, std::int32_t h, std::int32_t i0, std::int32_t i1, std::int32_t j0,
+                   std::int32_t j1) {
+    const std::int32_t k = f.window, N = f.frames;
     const std::int32_t i_end = N - k + 1, j_begin = k - 1;  // valid i < i_end, j ≥ j_begin
-    const std::int32_t ci0 = std::max(i0, 0), ci1 = std::min(i1, i_end);
-    const std::int32_t cj0 = std::max(j0, j_begin), cj1 = std::min(j1, N);
-    if (ci0 >= ci1 || cj0 >= cj1) return;
-    const std::int32_t ei0 = std::max(ci0 - h, 0), ei1 = std::min(ci1 + h, i_end);
-    const std::int32_t ej0 = std::max(cj0 - h, j_begin), ej1 = std::min(cj1 + h, N);
+    TileSpan t{};
+    t.ci0 = std::max(i0, 0), t.ci1 = std::min(i1, i_end);
+    t.cj0 = std::max(j0, j_begin), t.cj1 = std::min(j1, N);
+    if (t.empty()) return t;
+    t.ei0 = std::max(t.ci0 - h, 0), t.ei1 = std::min(t.ci1 + h, i_end);
+    t.ej0 = std::max(t.cj0 - h, j_begin), t.ej1 = std::min(t.cj1 + h, N);
+    return t;
+}
+
+// Product rows per dgemm call (fill_region). 12 000 synthetic frames, CPU seconds of the
+// whole build: 32 rows 2.31, 64 2.29, 128 2.25, all rows at once 2.56 (each call repacks
+// the columns' operand, so small bands pay that; all at once streams the products through memory).
+constexpr std::int32_t kBand = 64;
+
+// The bounds [lo, hi] of every pair i ∈ [ei0, ei1), j ∈ [ej0, ej1) (valid: i < N − k + 1,
+// j ≥ k − 1) into s.box_lo / s.box_hi, rows ej1 − ej0 apart: three dgemm products of
+// the frames, the window sums slid along the diagonals, the distances in double.
+
+void fill_region(const FrameFeatures& f, const CandidateSearchOptions& o, const DistanceErrorBound& bound,
+                 std::int32_t ei0, std::int32_t ei1, std::int32_t ej0, std::int32_t ej1, TileScratch& s) {
+    const std::int32_t k = f.window;
     const std::int32_t nr = ei1 - ei0 + k - 1, nc = ej1 - ej0 + k - 1;
     const std::int32_t row0 = ei0, col0 = ej0 - k + 1;
     const int J = f.joints, width = 2 * J;
-    const size_t cells = static_cast<size_t>(nr) * static_cast<size_t>(nc);
-    s.ca.ensure(cells);
-    s.cb.ensure(cells);
-    s.cy.ensure(cells);
-    // Cross terms of every frame pair of the tile: C[r][c] = frame (row0+r) · frame (col0+c).
-    row_dots(f.xz.data(), row0, nr, f.xz.data(), col0, nc, width, s.ca.data());
-    row_dots(f.xz.data(), row0, nr, f.zx.data(), col0, nc, width, s.cb.data());
-    row_dots(f.y.data(), row0, nr, f.y.data(), col0, nc, J, s.cy.data());
-    if (o.product_noise > 0.0) {
-        perturb_products(s.ca.data(), row0, nr, col0, nc, o.product_noise * bound.product_xz, 0);
-        perturb_products(s.cb.data(), row0, nr, col0, nc, o.product_noise * bound.product_xz, 1);
-        perturb_products(s.cy.data(), row0, nr, col0, nc, o.product_noise * bound.product_y, 2);
-    }
+    // Cross terms of the box's frame pairs, C[r][c] = frame (row0+r) · frame (col0+c), made
+    // kBand rows at a time as the rows' sums need them, into a ring of kBand + k rows: what the
+    // sums read stays in the core's cache instead of streaming megabytes through memory.
+    const std::int32_t ring = std::min(nr, kBand + k);
+    const size_t ucols = static_cast<size_t>(nc);
+    s.ca.ensure(static_cast<size_t>(ring) * ucols);
+    s.cb.ensure(static_cast<size_t>(ring) * ucols);
+    s.cy.ensure(static_cast<size_t>(ring) * ucols);
+    std::int32_t made = 0;  // rows [0, made) were made; the ring holds the last `ring` of them
+    // Rows up to `last` (r + k − 1 for row r, which reads product rows r − 1 … r + k − 1): a band
+    // starts at made ≤ last and overwrites rows up to made − ring + kBand − 1 ≤ last − k − 1 = r − 2.
+    const auto products_through = [&](std::int32_t last) {
+        while (made <= last) {
+            const std::int32_t slot = made % ring, rows = std::min({kBand, nr - made, ring - slot});
+            const size_t at = static_cast<size_t>(slot) * ucols;
+            row_dots(f.xz.data(), row0 + made, rows, f.xz.data(), col0, nc, width, s.ca.data() + at);
+            row_dots(f.xz.data(), row0 + made, rows, f.zx.data(), col0, nc, width, s.cb.data() + at);
+            row_dots(f.y.data(), row0 + made, rows, f.y.data(), col0, nc, J, s.cy.data() + at);
+            if (o.product_noise > 0.0) {
+                perturb_products(s.ca.data() + at, row0 + made, rows, col0, nc, o.product_noise * bound.product_xz, 0);
+                perturb_products(s.cb.data() + at, row0 + made, rows, col0, nc, o.product_noise * bound.product_xz, 1);
+                perturb_products(s.cy.data() + at, row0 + made, rows, col0, nc, o.product_noise * bound.product_y, 2);
+            }
+            made += rows;
+        }
+    };
 
     const std::int32_t dr = ei1 - ei0, dc = ej1 - ej0;
     s.row_cx.assign(f.cx.begin() + row0, f.cx.begin() + row0 + nr);
@@ -553,7 +616,7 @@ void run_tile(const FrameFeatures& f, const CandidateSearchOptions& o, const Dis
     s.col_cx.assign(f.cx.begin() + col0, f.cx.begin() + col0 + nc);
     s.col_cz.assign(f.cz.begin() + col0, f.cz.begin() + col0 + nc);
     const TileTerms terms{s.ca.data(), s.cb.data(), s.cy.data(), s.row_cx.data(), s.row_cz.data(),
-                          s.col_cx.data(), s.col_cz.data(), static_cast<size_t>(nc)};
+                          s.col_cx.data(), s.col_cz.data(), ucols, static_cast<size_t>(ring)};
 
     // Per column: window B's spread and W/k · Σ centroid; columns whose window leaves its clip.
     const size_t udc = static_cast<size_t>(dc);
@@ -571,14 +634,15 @@ void run_tile(const FrameFeatures& f, const CandidateSearchOptions& o, const Dis
     }
     // Window sums row by row: row 0 and column 0 directly, the rest by sliding along
     // the diagonals (two double adds per sum and pair instead of k).
-    s.d.ensure(static_cast<size_t>(dr) * udc);
-    s.hi.ensure(static_cast<size_t>(dr) * udc);
+    s.box_lo.ensure(static_cast<size_t>(dr) * udc);
+    s.box_hi.ensure(static_cast<size_t>(dr) * udc);
     s.sums[0].resize(kSumCount * udc);
     s.sums[1].resize(kSumCount * udc);
     const double inv_wk = 1.0 / (f.weight * k);
     for (std::int32_t r = 0; r < dr; ++r) {
         double* cur = s.sums[static_cast<size_t>(r & 1)].data();
         const double* prev = s.sums[static_cast<size_t>((r + 1) & 1)].data();
+        products_through(r + k - 1);  // row r's windows end on product row r + k − 1
         if (r == 0) {
             for (std::int32_t c = 0; c < dc; ++c) direct_window_sums(terms, 0, c, k, dc, cur);
         } else {
@@ -587,8 +651,8 @@ void run_tile(const FrameFeatures& f, const CandidateSearchOptions& o, const Dis
         }
         const std::int32_t i = ei0 + r;
         const size_t ui = static_cast<size_t>(i);
-        float* __restrict lo = s.d.data() + static_cast<size_t>(r) * udc;
-        float* __restrict hi = s.hi.data() + static_cast<size_t>(r) * udc;
+        float* __restrict lo = s.box_lo.data() + static_cast<size_t>(r) * udc;
+        float* __restrict hi = s.box_hi.data() + static_cast<size_t>(r) * udc;
         if (!f.start_ok[ui]) {
             std::fill(lo, lo + dc, kPairInvalid);
             std::fill(hi, hi + dc, kPairInvalid);
@@ -605,8 +669,55 @@ void run_tile(const FrameFeatures& f, const CandidateSearchOptions& o, const Dis
             if (f.clip_of[static_cast<size_t>(col0 + c)] == f.clip_of[ui] && lo[c] != kPairInvalid)
                 lo[c] = hi[c] = kPairExcluded;
     }
+}
 
-    decide_tile_minima(f, o, TileSpan{ci0, ci1, cj0, cj1, ei0, ei1, ej0, ej1}, s);
+// Tiles (a, b) and (b, a) from one computed box. The window distance is symmetric: pair
+// (i, j) of tile (b, a) (windows starting at i and at g = j − k + 1) is pair
+// (g, i + k − 1) of the box, whose interval holds the exact distance of the two
+// windows, hence (the bound covers both kernels' errors) the fixed-order kernel's
+// float for (i, j) as well. The pair validity and the near-diagonal exclusion are
+// symmetric too. So one box of (T + 2h + k − 1)² pairs serves both tiles, instead of
+// two of (T + 2h)², and each tile is decided as before, on its own cells.
+void run_tile_pair(const FrameFeatures& f, const CandidateSearchOptions& o, const DistanceErrorBound& bound,
+                   std::int32_t T, std::int32_t a, std::int32_t b, TileScratch& s) {
+    const std::int32_t k = f.window, h = o.neighbourhood;
+    TileSpan p = tile_span(f, h, a * T, (a + 1) * T, b * T, (b + 1) * T);
+    TileSpan q = a == b ? TileSpan{} : tile_span(f, h, b * T, (b + 1) * T, a * T, (a + 1) * T);
+    if (p.empty() && q.empty()) return;
+    std::int32_t r0 = std::numeric_limits<std::int32_t>::max(), r1 = std::numeric_limits<std::int32_t>::min();
+    std::int32_t c0 = r0, c1 = r1;
+    if (!p.empty()) r0 = p.ei0, r1 = p.ei1, c0 = p.ej0, c1 = p.ej1;
+    if (!q.empty()) {  // q's cell (i, j) is the box's (j − k + 1, i + k − 1)
+        r0 = std::min(r0, q.ej0 - k + 1), r1 = std::max(r1, q.ej1 - k + 1);
+        c0 = std::min(c0, q.ei0 + k - 1), c1 = std::max(c1, q.ei1 + k - 1);
+    }
+    fill_region(f, o, bound, r0, r1, c0, c1, s);
+    const size_t stride = static_cast<size_t>(c1 - c0);
+    if (!p.empty()) {
+        const size_t at = static_cast<size_t>(p.ei0 - r0) * stride + static_cast<size_t>(p.ej0 - c0);
+        p.lo = s.box_lo.data() + at, p.stride = stride;
+        p.hi = s.box_hi.data() + at, p.hi_i_step = stride, p.hi_j_step = 1;
+        decide_tile_minima(f, o, p, s);
+    }
+    if (q.empty()) return;
+    const std::int32_t rows = q.ei1 - q.ei0, cols = q.ej1 - q.ej0;
+    const size_t ucols = static_cast<size_t>(cols);
+    s.d.ensure(static_cast<size_t>(rows) * ucols);
+    // q[r][c] = box[c + q.ej0 − k + 1 − r0][r + q.ei0 + k − 1 − c0]: the lower bounds copied
+    // (every row is scanned), in 32 × 32 blocks (cache); the upper bounds read in place.
+    const size_t br = static_cast<size_t>(q.ej0 - k + 1 - r0), bc = static_cast<size_t>(q.ei0 + k - 1 - c0);
+    constexpr std::int32_t kBlock = 32;
+    for (std::int32_t r_0 = 0; r_0 < rows; r_0 += kBlock)
+        for (std::int32_t c_0 = 0; c_0 < cols; c_0 += kBlock)
+            for (std::int32_t r = r_0; r < std::min(r_0 + kBlock, rows); ++r)
+                for (std::int32_t c = c_0; c < std::min(c_0 + kBlock, cols); ++c) {
+                    const size_t from = (br + static_cast<size_t>(c)) * stride + bc + static_cast<size_t>(r);
+                    const size_t to = static_cast<size_t>(r) * ucols + static_cast<size_t>(c);
+                    s.d[to] = s.box_lo[from];
+                }
+    q.lo = s.d.data(), q.stride = ucols;
+    q.hi = s.box_hi.data() + br * stride + bc, q.hi_i_step = 1, q.hi_j_step = stride;
+    decide_tile_minima(f, o, q, s);
 }
 
 }  // namespace
@@ -615,16 +726,24 @@ CandidateSearchResult find_transition_candidates(const FrameFeatures& f, const C
     openblas_set_num_threads(1);  // parallel over tiles instead: one sgemm per thread at a time
     const std::int32_t T = std::max(16, o.tile);
     const std::int32_t tiles_per_side = (f.frames + T - 1) / T;
-    const std::int64_t tile_count = static_cast<std::int64_t>(tiles_per_side) * tiles_per_side;
+    // Work items: the tile pairs (a, b), a ≤ b, each one box for tiles (a, b) and (b, a).
+    std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
+    for (std::int32_t a = 0; a < tiles_per_side; ++a)
+        for (std::int32_t b = a; b < tiles_per_side; ++b) pairs.push_back({a, b});
+    const std::int64_t tile_count = static_cast<std::int64_t>(pairs.size());
     const int threads = static_cast<int>(std::min<std::int64_t>(thread_count(o.threads), std::max<std::int64_t>(tile_count, 1)));
-    // A tile's rows are slid at most T + 2h − 1 times from its directly summed first row.
-    const DistanceErrorBound bound = window_distance_error_bound(f, T + 2 * o.neighbourhood);
+    // A box's rows (at most T + 2h + k − 1) are slid at most T + 2h + k − 2 times from its
+    // directly summed first row.
+    const DistanceErrorBound bound = window_distance_error_bound(f, T + 2 * o.neighbourhood + f.window);
     std::vector<TileScratch> scratch(static_cast<size_t>(threads));
-    {  // the largest tile plus halo, once: no reallocation as tile sizes vary
+    {  // the largest box, once: no reallocation as box sizes vary
         const size_t side = static_cast<size_t>(std::min(T + 2 * o.neighbourhood + f.window - 1, std::max(f.frames, 1)));
+        const size_t frames = side + static_cast<size_t>(f.window) - 1;
+        const size_t ring = std::min(frames, static_cast<size_t>(kBand + f.window));
         for (TileScratch& s : scratch) {
-            s.ca.ensure(side * side), s.cb.ensure(side * side), s.cy.ensure(side * side);
-            s.d.ensure(side * side), s.hi.ensure(side * side);
+            s.ca.ensure(ring * frames), s.cb.ensure(ring * frames), s.cy.ensure(ring * frames);
+            s.box_lo.ensure(side * side), s.box_hi.ensure(side * side);
+            s.d.ensure(side * side);
         }
     }
     if (o.plot)
@@ -633,9 +752,8 @@ CandidateSearchResult find_transition_candidates(const FrameFeatures& f, const C
     std::atomic<std::int64_t> next{0}, done{0};
     const auto work = [&](int t) {
         for (std::int64_t tile = next++; tile < tile_count; tile = next++) {
-            const std::int32_t ti = static_cast<std::int32_t>(tile / tiles_per_side);
-            const std::int32_t tj = static_cast<std::int32_t>(tile % tiles_per_side);
-            run_tile(f, o, bound, ti * T, (ti + 1) * T, tj * T, (tj + 1) * T, scratch[static_cast<size_t>(t)]);
+            const auto [a, b] = pairs[static_cast<size_t>(tile)];
+            run_tile_pair(f, o, bound, T, a, b, scratch[static_cast<size_t>(t)]);
             ++done;
             if (t == 0 && o.progress) o.progress(static_cast<double>(done.load()) / static_cast<double>(tile_count));
         }
