@@ -179,6 +179,51 @@ TEST_CASE("transition candidates do not depend on BLAS rounding, tile size or th
     }
 }
 
+// The tiled search against its specification, bit for bit: the local-minimum rule
+// (local_minima) on the dense matrix of the fixed-order kernel's floats, on generated
+// databases (fixed seeds) across clip counts, lengths, noise, window, neighbourhood,
+// threshold, tile size (tiles are computed in symmetric pairs: small tiles give many
+// mirrored boxes, ragged edges and halos across them) and thread count.
+TEST_CASE("the tiled search equals the local-minimum rule on the fixed-order matrix for generated databases",
+          "[graph][distance][blas]") {
+    for (unsigned seed = 1; seed <= 24; ++seed) {
+        std::mt19937 rng(seed);
+        const auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
+        const auto pick = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+        std::vector<Clip> clips;
+        const int count = pick(1, 5);
+        const double noise = seed % 4 == 0 ? 0.0 : uniform(0.0, 0.1);  // every fourth exactly periodic
+        for (int c = 0; c < count; ++c)
+            clips.push_back(synthetic_clip("clip" + std::to_string(seed) + "_" + std::to_string(c), pick(12, 110),
+                                           uniform(0.0, 6.3), uniform(0.3, 2.0), noise));
+        const ClipDatabase db = make_clip_database(std::move(clips), {}, LabelRules{}, 30.0);
+        const int k = pick(2, 10);
+        const FrameFeatures f = compute_frame_features(db, database_positions(db), k, uniform(0.5, 2.0));
+        CandidateSearchOptions o;
+        o.neighbourhood = pick(1, 4);
+        o.threshold = distance_percentiles(f, {uniform(1.0, 30.0)})[0];
+        o.tile = pick(16, 80);
+        o.threads = pick(1, 3);
+        o.product_noise = uniform(-1.0, 1.0);
+        INFO("seed " << seed << ": " << f.frames << " frames, k " << k << ", h " << o.neighbourhood << ", tile " << o.tile
+                     << ", threads " << o.threads);
+        const size_t n = static_cast<size_t>(f.frames);
+        std::vector<float> exact(n * n);
+        for (std::int32_t i = 0; i < f.frames; ++i)
+            for (std::int32_t j = 0; j < f.frames; ++j)
+                exact[static_cast<size_t>(i) * n + static_cast<size_t>(j)] = static_cast<float>(feature_pair_distance(f, i, j));
+        const auto expected = local_minima(exact, f.frames, f.frames, o.neighbourhood, o.threshold);
+        const CandidateSearchResult tiled = find_transition_candidates(f, o);
+        REQUIRE(tiled.candidates.size() == expected.size());
+        for (size_t c = 0; c < expected.size(); ++c) {
+            CHECK(tiled.candidates[c].from_frame == expected[c].first);
+            CHECK(tiled.candidates[c].to_frame == expected[c].second);
+            const float v = exact[static_cast<size_t>(expected[c].first) * n + static_cast<size_t>(expected[c].second)];
+            CHECK(std::memcmp(&tiled.candidates[c].distance, &v, sizeof(float)) == 0);
+        }
+    }
+}
+
 TEST_CASE("a BLAS result outside the error bound fails the search instead of deciding", "[graph][distance][blas]") {
     // Products moved by a million times the allowance: the fixed-order values of the
     // cells it proposes fall outside their intervals, and the search says so.
@@ -253,6 +298,20 @@ TEST_CASE("CMU subject 16 builds a graph whose largest component keeps walk, run
     for (std::uint8_t c : g.contacts) left += (c & kContactLeft) != 0, right += (c & kContactRight) != 0;
     CHECK(left > 50);
     CHECK(right > 50);
+}
+
+// The CMU subject-16 graph's bytes, pinned: a faster search must find exactly the same
+// transitions. (The value is this build's after the symmetric tile pairs of 2026-12-02;
+// main's before them gave the same bytes for these nine clips with the benchmark's labels,
+// and `graph build` of all the CMU-16 clips gave a file identical to main's, cmp. The
+// embedded default graph is pinned the same way by tests/golden/default_graph.hash.)
+TEST_CASE("the CMU subject-16 graph keeps its bytes", "[graph][cmu][determinism]") {
+    if (test::mocap_dir().empty()) return;
+    const std::vector<std::uint8_t> bytes = serialize_motion_graph(cmu16_graph().graph);
+    std::uint64_t hash = 0xcbf29ce484222325ull;  // FNV-1a
+    for (const std::uint8_t b : bytes) hash = (hash ^ b) * 0x100000001b3ull;
+    INFO("FNV-1a of the serialized graph: " << std::hex << hash);
+    CHECK(hash == 0x61276c21988ffb66ull);
 }
 
 TEST_CASE("CMU paths reach every label from every kept clip with continuous poses", "[graph][cmu][path]") {
