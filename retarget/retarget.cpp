@@ -40,18 +40,20 @@ vec3 point_of(const std::vector<vec3>& p, SourcePoint s) {
 }
 using detail::point_of;
 
-// A Z-up source turned Y-up: its roots' rotations, translations and offsets.
+// A Z-up source turned Y-up as a whole: every offset turned, every local
+// rotation conjugated, the roots' translations turned.
 void make_y_up(Clip& clip) {
     const quat c = quat_wxyz(0.70710678f, -0.70710678f, 0.0f, 0.0f);  // −90° about X: +Z → +Y
-    for (int j = 0; j < clip.joint_count(); ++j) {
-        if (clip.skeleton.parents[static_cast<size_t>(j)] != kNoParent) continue;
-        clip.skeleton.rest_offsets[static_cast<size_t>(j)] = quat_rotate(c, clip.skeleton.rest_offsets[static_cast<size_t>(j)]);
-        for (int f = 0; f < clip.frame_count; ++f) {
+    const quat ci = quat_conjugate(c);
+    Skeleton& s = clip.skeleton;
+    for (vec3& o : s.rest_offsets) o = quat_rotate(c, o);
+    for (vec3& o : s.end_site_offsets) o = quat_rotate(c, o);
+    for (int f = 0; f < clip.frame_count; ++f)
+        for (int j = 0; j < clip.joint_count(); ++j) {
             const size_t i = at(f, clip.joint_count(), j);
-            clip.rotations[i] = quat_mul(c, clip.rotations[i]);
+            clip.rotations[i] = quat_normalize(quat_mul(quat_mul(c, clip.rotations[i]), ci));
             clip.translations[i] = quat_rotate(c, clip.translations[i]);
         }
-    }
 }
 
 int end_site_of(const Skeleton& s, int j) {
@@ -131,9 +133,30 @@ void transfer_frames(const ModelFrames& m, const HumanoidChains& h, const Transf
                 p == kNoParent ? world[u] : quat_normalize(quat_mul(quat_conjugate(world[static_cast<size_t>(p)]), world[u]));
             out.translations[at(f, n, r)] = puppet.rest_offsets[u];
         }
-        const vec3 root = point_of(m, f, h.from[role::pelvis]) - vec3(0.0f, t.floor, 0.0f);
-        out.translations[at(f, n, 0)] = t.scale * quat_rotate(t.yaw, root);
+        // The pelvis goes where the hips' midpoint puts it: the puppet's hips on the
+        // source's (scaled), whatever the source root's height above them.
+        const vec3 hips = 0.5f * (m.position(f, h.joint[role::thigh_l]) + m.position(f, h.joint[role::thigh_r]));
+        const vec3 hip_offset = 0.5f * (puppet.rest_offsets[role::thigh_l] + puppet.rest_offsets[role::thigh_r]);
+        out.translations[at(f, n, 0)] =
+            t.scale * quat_rotate(t.yaw, hips - vec3(0.0f, t.floor, 0.0f)) - quat_rotate(world[role::pelvis], hip_offset);
     }
+}
+
+// The ground under the motion: per frame the lowest foot point, and of those
+// the 2nd percentile, so a few glitched frames do not sink the ground.
+float motion_floor(const ModelFrames& m, const HumanoidChains& h) {
+    const int frames = static_cast<int>(m.positions.size() / static_cast<size_t>(m.points));
+    std::vector<float> lowest;
+    for (int f = 0; f < frames; ++f) {
+        float low = m.position(f, h.joint[role::foot_l]).y;
+        for (int r : {role::foot_l, role::toe_l, role::foot_r, role::toe_r}) {
+            low = std::min(low, point_of(m, f, h.from[static_cast<size_t>(r)]).y);
+            low = std::min(low, point_of(m, f, h.to[static_cast<size_t>(r)]).y);
+        }
+        lowest.push_back(low);
+    }
+    std::sort(lowest.begin(), lowest.end());
+    return lowest[lowest.size() / 50];
 }
 
 void measure_agreement(const Clip& out, const Transfer& t, const HumanoidChains& h, const Skeleton& src,
@@ -191,10 +214,14 @@ RetargetResult retarget_clip(const Clip& source, const Skeleton& puppet, const s
     out.animated_translation[0] = true;
     out.length_unit = 1.0;
     const ModelFrames m = model_frames(src);
+    // The ground under the motion: the lowest foot point over the clip (the rest
+    // pose may stand anywhere, as ASF's root at the origin does).
+    Transfer tm = t;
+    tm.floor = motion_floor(m, h);
     std::vector<vec3> src_dirs;
-    transfer_frames(m, h, t, puppet, out, src_dirs);
-    detail::fix_contacts(m, h, detail::SourceToPuppet{t.yaw, t.scale, t.floor}, o, puppet_leg, result);
-    measure_agreement(out, t, h, src.skeleton, src_dirs, result.bones);
+    transfer_frames(m, h, tm, puppet, out, src_dirs);
+    detail::fix_contacts(m, h, detail::SourceToPuppet{tm.yaw, tm.scale, tm.floor}, o, puppet_leg, result);
+    measure_agreement(out, tm, h, src.skeleton, src_dirs, result.bones);
     return result;
 }
 

