@@ -329,7 +329,7 @@ TEST_CASE("retarget: not a humanoid is an error naming the file", "[retarget]") 
     }
 }
 
-TEST_CASE("retarget: map files override roles; malformed ones are refused with file, line and key", "[retarget]") {
+TEST_CASE("retarget: map files override roles, malformed ones are refused with file, line and key", "[retarget]") {
     const Generated g = generate(2);
     {
         // A map naming the left thigh's joint as the right one's: honoured.
