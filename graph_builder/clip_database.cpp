@@ -7,6 +7,7 @@
 
 #include <algorithm>
 
+#include "retarget/retarget.hpp"
 #include "runtime/formats/asf_amc.hpp"
 #include "runtime/formats/bvh.hpp"
 #include "runtime/formats/file_names.hpp"
@@ -59,9 +60,13 @@ LabelRules parse_label_rules(const std::string& text, const std::string& origin)
     for (const auto& [key, node] : doc) {
         const std::string table(key.str());
         const toml::table* t = node.as_table();
+        if (t && table == "retarget") {
+            rules.retarget_map = retarget::parse_retarget_map(text, origin, true);
+            continue;
+        }
         if (!t || (table != "labels" && table != "joint_weights" && table != "contacts"))
             throw ImportError(origin, line_of(node),
-                              "unknown entry '" + table + "' (expected the tables [labels], [joint_weights], [contacts])");
+                              "unknown entry '" + table + "' (expected the tables [labels], [joint_weights], [contacts], [retarget])");
         for (const auto& [k, v] : *t) {
             const std::string name(k.str());
             const std::string full = table + "." + name;
@@ -189,7 +194,7 @@ ClipDatabase make_clip_database(std::vector<Clip> clips, const std::vector<std::
 }
 
 ClipDatabase load_clip_database(const std::vector<std::string>& files, const std::string& asf_file,
-                                const LabelRules& rules, double rate) {
+                                const LabelRules& rules, double rate, const Skeleton* retarget_to) {
     std::vector<Clip> clips;
     std::vector<std::string> names;
     for (const std::string& f : files) {
@@ -204,6 +209,12 @@ ClipDatabase load_clip_database(const std::vector<std::string>& files, const std
             throw ImportError(f, 0, "unknown clip format '." + ext + "' (expected .bvh, or .amc with --asf)");
         }
         names.push_back(f);
+        if (retarget_to && !retarget::is_puppet_skeleton(clips.back().skeleton, *retarget_to)) {
+            retarget::RetargetOptions options;
+            const bool mapped = !rules.retarget_map.roles.empty() || !rules.retarget_map.up.empty();
+            if (mapped) options.map = &rules.retarget_map;
+            clips.back() = retarget::retarget_clip(clips.back(), *retarget_to, f, options).clip;
+        }
     }
     if (clips.empty()) throw ImportError(files.empty() ? rules.origin : files.front(), 0, "no clip files given");
     return make_clip_database(std::move(clips), names, rules, rate);

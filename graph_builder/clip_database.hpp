@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "retarget/humanoid.hpp"
 #include "runtime/anim/clip.hpp"
 
 namespace marionette::offline {
@@ -13,7 +14,8 @@ namespace marionette::offline {
 // A labels file (TOML, docs/motion-graph.md): [labels] maps clip-name patterns
 // (shell globs, matched against the file name without extension) to label lists;
 // [joint_weights] maps joint-name patterns to distance weights (default 1);
-// [contacts] may name the left_foot and right_foot joints.
+// [contacts] may name the left_foot and right_foot joints; [retarget] names
+// source joints for the retargeter (docs/retarget.md) when clips are retargeted.
 struct LabelRules {
     std::string origin;  // file name, for messages and the source hash
     std::string text;    // the TOML text
@@ -21,6 +23,7 @@ struct LabelRules {
     std::vector<std::pair<std::string, float>> joint_weights;
     std::string left_foot;
     std::string right_foot;
+    retarget::RetargetMap retarget_map;  // empty unless the file has [retarget]
 };
 
 // Throws ImportError naming the file, line and key on malformed input.
@@ -44,8 +47,11 @@ struct ClipDatabase {
 
 // Loads every clip (BVH, or AMC with `asf_file`), checks one shared skeleton (the
 // error names the first clip and joint that differ) and resamples. Throws ImportError.
+// With `retarget_to` (the puppet's skeleton), every clip of another skeleton is
+// first retargeted onto it (retarget/retarget.hpp, with the rules' [retarget]
+// table), so any humanoid clips, of any mix of skeletons, make one database.
 ClipDatabase load_clip_database(const std::vector<std::string>& clip_files, const std::string& asf_file,
-                                const LabelRules& rules, double analysis_rate_hz);
+                                const LabelRules& rules, double analysis_rate_hz, const Skeleton* retarget_to = nullptr);
 
 // Same from clips already in memory (tests, benchmarks, generated clips).
 ClipDatabase make_clip_database(std::vector<Clip> clips, const std::vector<std::string>& names_for_errors,

@@ -1,4 +1,4 @@
-// `marionette clip info` and `marionette clip fk`.
+// `marionette clip info`, `marionette clip fk` and `marionette clip retarget`.
 #include <fmt/format.h>
 
 #include <cstdio>
@@ -8,6 +8,9 @@
 #include "app/cli/commands.hpp"
 #include "app/io/files.hpp"
 #include "app/io/json.hpp"
+#include "app/config/config.hpp"
+#include "retarget/retarget.hpp"
+#include "runtime/gait/puppet.hpp"
 #include "runtime/formats/asf_amc.hpp"
 #include "runtime/formats/bvh.hpp"
 #include "runtime/formats/file_names.hpp"
@@ -94,6 +97,67 @@ int clip_fk_command(const ClipOptions& o) {
     return 0;
 }
 
+int clip_retarget_command(const ClipOptions& o) {
+    const std::string ext = lower_extension(o.file);
+    if (ext != "bvh" && ext != "amc")
+        throw ImportError(o.file, 0, "clip retarget needs a motion: a .bvh, or an .amc with --asf SKELETON.asf");
+    const Clip source = load_clip(o);
+    if (source.frame_count < 1) throw ImportError(o.file, 0, "the clip has no frames to retarget");
+    const AppConfig config = load_config(o.config_file);
+    const Skeleton puppet = make_puppet_skeleton(config.sim);
+    retarget::RetargetMap map;
+    retarget::RetargetOptions options;
+    if (!o.map_file.empty()) {
+        map = retarget::parse_retarget_map(read_text_file(o.map_file), o.map_file);
+        options.map = &map;
+    }
+    const retarget::RetargetResult r = retarget::retarget_clip(source, puppet, o.file, options);
+    write_text_file(o.output_file, export_bvh(r.clip));
+    const retarget::HumanoidChains& h = r.chains;
+    const Skeleton& s = source.skeleton;
+    double worst_mean = 1.0, worst_min = 1.0;
+    for (const retarget::BoneAgreement& b : r.bones) {
+        worst_mean = std::min(worst_mean, b.mean_cos);
+        worst_min = std::min(worst_min, b.min_cos);
+    }
+    if (o.json) {
+        std::string roles, bones, notes;
+        const auto& names = retarget::role_names();
+        for (size_t k = 0; k < names.size(); ++k)
+            roles += fmt::format("{}{}:{}", k ? "," : "", json::quote(names[k]), json::quote(s.joint_names[static_cast<size_t>(h.joint[k])]));
+        for (const retarget::BoneAgreement& b : r.bones)
+            bones += fmt::format("{}{{\"puppet\":{},\"source\":{},\"mean_cos\":{},\"min_cos\":{}}}", bones.empty() ? "" : ",",
+                                 json::quote(b.puppet_joint), json::quote(b.source_joint), json::number(b.mean_cos),
+                                 json::number(b.min_cos));
+        for (const std::string& n : h.notes) notes += (notes.empty() ? "" : ",") + json::quote(n);
+        const char* effector_names[5] = {"head", "left_foot", "right_foot", "left_hand", "right_hand"};
+        std::string effectors;
+        for (size_t k = 0; k < 5; ++k)
+            effectors += fmt::format("{}{}:{}", k ? "," : "", json::quote(effector_names[k]),
+                                     json::quote(s.joint_names[static_cast<size_t>(h.effectors[k])]));
+        fmt::print("{{\"file\":{},\"output\":{},\"frames\":{},\"frame_rate\":{},\"scale\":{},\"source_leg_length\":{},"
+                   "\"side_from\":{},\"names_agree\":{},\"effectors\":{{{}}},\"chains\":{{{}}},\"notes\":[{}],\"bones\":[{}],"
+                   "\"min_mean_cos\":{},\"min_cos\":{},\"contacts\":{{\"runs\":{},\"frames\":{},\"max_drift_m\":{},\"mean_drift_m\":{},"
+                   "\"max_drift_before_ik_m\":{},\"max_root_drop_m\":{}}}}}\n",
+                   json::quote(o.file), json::quote(o.output_file), r.clip.frame_count, json::number(r.clip.frame_rate),
+                   json::number(r.scale), json::number(h.source_leg_length), json::quote(h.side_from), h.names_agree ? "true" : "false",
+                   effectors, roles, notes, bones, json::number(worst_mean), json::number(worst_min), r.contacts.runs,
+                   r.contacts.frames, json::number(r.contacts.max_drift_m), json::number(r.contacts.mean_drift_m),
+                   json::number(r.contacts.max_drift_before_ik_m), json::number(r.contacts.max_root_drop_m));
+    } else {
+        fmt::print("{}: humanoid found (sides from {}), {} frames at {} Hz, scale {:.4g}\n", o.file, h.side_from,
+                   r.clip.frame_count, r.clip.frame_rate, r.scale);
+        for (size_t k = 0; k < r.bones.size(); ++k)
+            fmt::print("{:>12} <- {:<24} mean cos {:.4f}  min {:.4f}\n", r.bones[k].puppet_joint, r.bones[k].source_joint,
+                       r.bones[k].mean_cos, r.bones[k].min_cos);
+        fmt::print("contacts: {} runs, {} foot-frames, drift max {:.2f} mm mean {:.2f} mm (before IK {:.1f} mm)\n",
+                   r.contacts.runs, r.contacts.frames, r.contacts.max_drift_m * 1000.0, r.contacts.mean_drift_m * 1000.0,
+                   r.contacts.max_drift_before_ik_m * 1000.0);
+        fmt::print("wrote {}\n", o.output_file);
+    }
+    return 0;
+}
+
 void register_clip_commands(CLI::App& app, int& exit_code) {
     auto o = std::make_shared<ClipOptions>();
     CLI::App* clip = app.add_subcommand("clip", "Inspect motion-capture clips (BVH, ASF/AMC)");
@@ -108,6 +172,14 @@ void register_clip_commands(CLI::App& app, int& exit_code) {
     fk->add_option("--frame", o->frame, "0-based frame index in the file")->required();
     on_parsed(info, exit_code, [o] { return clip_info_command(*o); });
     on_parsed(fk, exit_code, [o] { return clip_fk_command(*o); });
+    CLI::App* rt = clip->add_subcommand("retarget", "Retarget a humanoid clip onto the puppet's skeleton (docs/retarget.md)");
+    rt->add_option("file", o->file, "clip file (.bvh, or .amc with --asf)")->required();
+    rt->add_option("--asf", o->asf_file, "skeleton for an AMC file");
+    rt->add_option("--map", o->map_file, "TOML file with a [retarget] table naming source joints per puppet joint");
+    rt->add_option("--config", o->config_file, "TOML file whose [gait] proportions shape the puppet");
+    rt->add_option("-o,--output", o->output_file, "the BVH file to write")->required();
+    rt->add_flag("--json", o->json, "print the chains found and per-bone direction agreement as JSON");
+    on_parsed(rt, exit_code, [o] { return clip_retarget_command(*o); });
 }
 
 }  // namespace marionette

@@ -48,8 +48,12 @@ struct ClipOptions {
     std::string asf_file;
     int frame = 0;
     bool json = false;
+    std::string map_file;     // retarget: [retarget] table
+    std::string config_file;  // retarget: the puppet's proportions
+    std::string output_file;  // retarget: BVH out
 };
 int clip_info_command(const ClipOptions& options);
+int clip_retarget_command(const ClipOptions& options);
 int clip_fk_command(const ClipOptions& options);
 
 }  // namespace marionette

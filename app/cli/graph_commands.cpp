@@ -23,6 +23,7 @@
 #include "graph_builder/graph_builder.hpp"
 #include "render_es/image.hpp"
 #include "runtime/formats/bvh.hpp"
+#include "runtime/gait/puppet.hpp"
 #include "runtime/graph/graph_path.hpp"
 
 namespace marionette {
@@ -39,6 +40,7 @@ struct GraphBuildCommandOptions {
     std::string dot_file;
     int threads = 0;
     bool json = false;
+    bool keep_skeleton = false;  // --keep-skeleton: no retargeting onto the puppet
     bool default_graph = false;  // --default: the embedded default graph (app/graph/default_graph.hpp)
 };
 
@@ -221,12 +223,15 @@ int graph_build_command(const GraphBuildCommandOptions& o) {
     if (o.default_graph) return graph_default_build_command(o);
     if (o.clip_files.empty())
         throw ImportError("command line", 0, "graph build needs CLIPS (.bvh, or .amc with --asf), or --default");
-    const GraphBuildConfig build_config = load_config(o.config_file).graph_build;
+    const AppConfig app_config = load_config(o.config_file);
+    const GraphBuildConfig& build_config = app_config.graph_build;
     const GraphSources sources{o.asf_file, o.clip_files, o.labels_file};
     offline::GraphBuildParams params = graph_build_params(build_config);
     params.threads = o.threads;
     const auto started = std::chrono::steady_clock::now();
-    const offline::ClipDatabase db = load_graph_sources(sources, params.analysis_rate_hz);
+    // Clips of any humanoid skeleton are retargeted onto the puppet as they load.
+    const Skeleton puppet = make_puppet_skeleton(app_config.sim);
+    const offline::ClipDatabase db = load_graph_sources(sources, params.analysis_rate_hz, o.keep_skeleton ? nullptr : &puppet);
 
     offline::GraphBuildHooks hooks;
     const bool bar = isatty(fileno(stderr)) != 0;
@@ -427,6 +432,8 @@ void register_graph_commands(CLI::App& app, int& exit_code) {
     CLI::App* build = graph->add_subcommand("build", "Build a motion graph from BVH or ASF/AMC clips");
     build->add_option("--asf", b->asf_file, "skeleton for AMC clips")->check(CLI::ExistingFile);
     build->add_option("clips", b->clip_files, "clip files (.bvh, or .amc with --asf)");
+    build->add_flag("--keep-skeleton", b->keep_skeleton,
+                    "keep the clips' own skeleton (one shared skeleton) instead of retargeting them onto the puppet");
     build->add_flag("--default", b->default_graph, "build the embedded default graph (project clips + gait locomotion)");
     build->add_option("-o,--output", b->output_file, "the .mgraph file to write")->required();
     build->add_option("--labels", b->labels_file, "labels file (TOML; default config/graph_labels.toml)")

@@ -12,15 +12,17 @@
 #include "app/config/embedded.hpp"
 #include "app/io/files.hpp"
 #include "app/graph/graph_files.hpp"
+#include "retarget/retarget.hpp"
+#include "runtime/gait/puppet.hpp"
 
 namespace marionette {
 
-offline::ClipDatabase load_graph_sources(const GraphSources& s, double analysis_rate_hz) {
+offline::ClipDatabase load_graph_sources(const GraphSources& s, double analysis_rate_hz, const Skeleton* retarget_to) {
     const offline::LabelRules rules =
         s.labels.empty()
             ? offline::parse_label_rules(std::string(embedded::find("config/graph_labels.toml")), "config/graph_labels.toml")
             : offline::parse_label_rules(read_text_file(s.labels), s.labels);
-    return offline::load_clip_database(s.clips, s.asf, rules, analysis_rate_hz);
+    return offline::load_clip_database(s.clips, s.asf, rules, analysis_rate_hz, retarget_to);
 }
 
 offline::GraphBuildOutput build_graph_from_sources(const offline::ClipDatabase& db, const GraphSources& s,
@@ -76,7 +78,9 @@ std::shared_ptr<const MotionGraph> load_graph_argument_rebuilding_stale(const st
     }
     offline::GraphBuildParams params = graph_build_params(build);
     const auto started = std::chrono::steady_clock::now();
-    const offline::ClipDatabase db = load_graph_sources(sources, params.analysis_rate_hz);
+    const Skeleton puppet = make_puppet_skeleton(config);
+    const bool on_puppet = retarget::is_puppet_skeleton(graph->skeleton, puppet);
+    const offline::ClipDatabase db = load_graph_sources(sources, params.analysis_rate_hz, on_puppet ? &puppet : nullptr);
     const std::uint64_t current_hash = offline::graph_source_hash(db.content_hash, params);
     if (current_hash == stored_hash) return graph;
     offline::GraphBuildOutput out = build_graph_from_sources(db, sources, params);

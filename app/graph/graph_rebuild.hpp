@@ -22,7 +22,10 @@ struct GraphSources {
 };
 
 // Loads the label rules and the clip database (throws ImportError naming the file).
-offline::ClipDatabase load_graph_sources(const GraphSources& sources, double analysis_rate_hz);
+// With `retarget_to` (the puppet's skeleton), clips of any other humanoid
+// skeleton are retargeted onto it as they load (docs/retarget.md).
+offline::ClipDatabase load_graph_sources(const GraphSources& sources, double analysis_rate_hz,
+                                         const Skeleton* retarget_to = nullptr);
 
 // Builds the pruned graph from a database loaded by load_graph_sources and
 // records the sources in it (so the file can be rebuilt when stale). Throws
@@ -42,7 +45,8 @@ void write_binary_file_atomically(const std::string& path, const std::vector<std
 // from them with the current parameters and written back atomically, with one
 // line on stderr saying why. Missing sources: the file is used as it is, with a
 // warning. A graph without recorded sources (e.g. `graph build --default`) is
-// used as it is. Replay must not use this: a rebuilt graph has other bytes than
+// used as it is. A graph on the puppet's skeleton is rebuilt with its clips
+// retargeted onto the puppet, as `graph build` made it. Replay must not use this: a rebuilt graph has other bytes than
 // the one the log was recorded with.
 std::shared_ptr<const MotionGraph> load_graph_argument_rebuilding_stale(const std::string& argument,
                                                                         const SimConfig& config,

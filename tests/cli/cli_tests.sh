@@ -75,14 +75,21 @@ if [[ -d $mocap/cmu_amc_16 ]]; then
   check "graph info claims no build time (the file stores none)" python3 -c "import json,sys; sys.exit(0 if 'build_seconds' not in json.load(open('info.json')) else 1)"
   check "graph info reports the pruned graph" python3 -c "import json,sys; a=json.load(open('info.json')); b=json.load(open('build.json')); sys.exit(0 if a['nodes']==b['nodes'] and a['edges']==b['edges'] else 1)"
   check "graph path finds a walk → run path and writes its BVH" bash -c "'$bin' graph path cmu16.mgraph --from 16_15:40 --to 16_35:20 --json --bvh path.bvh >path.json"
-  check "the path BVH imports" bash -c "'$bin' clip info path.bvh --json | grep -q '\"joints\":31'"
+  check "the path BVH imports, on the puppet's skeleton (clips retargeted on load)" bash -c "'$bin' clip info path.bvh --json | grep -q '\"joints\":22'"
   check "graph path reaches a label" bash -c "'$bin' graph path cmu16.mgraph --from 16_41:20 --to walk --json | grep -q '\"found\":true'"
   expect_error "graph path: unknown label" 2 "neither CLIP:FRAME nor a label" "$bin" graph path cmu16.mgraph --from 16_15:40 --to dance
   expect_error "graph path: frame out of range" 2 "expected a 0-based frame index" "$bin" graph path cmu16.mgraph --from 16_15:9999 --to walk
   head -c 100 cmu16.mgraph >cut.mgraph
   expect_error "graph info: truncated graph" 2 "cut.mgraph: at byte 24" "$bin" graph info cut.mgraph
   expect_error "graph build: AMC without skeleton" 2 "needs its skeleton" "$bin" graph build "$mocap/cmu_amc_16/16_15.amc" -o x.mgraph
-  expect_error "graph build: mixed skeletons" 2 "skeleton differs" "$bin" graph build --asf "$mocap/cmu_amc_16/16.asf" "$mocap/cmu_amc_16/16_15.amc" "$mocap/cmu_bvh_131/131_01.bvh" -o x.mgraph
+  expect_error "graph build --keep-skeleton: mixed skeletons" 2 "skeleton differs" "$bin" graph build --keep-skeleton --asf "$mocap/cmu_amc_16/16.asf" "$mocap/cmu_amc_16/16_15.amc" "$mocap/cmu_bvh_131/131_01.bvh" -o x.mgraph
+  check "graph build: mixed skeletons are retargeted onto the puppet" bash -c "'$bin' graph build --asf '$mocap/cmu_amc_16/16.asf' '$mocap/cmu_amc_16/16_15.amc' '$mocap/cmu_amc_16/16_35.amc' '$mocap/cmu_bvh_131/131_01.bvh' -o mixed.mgraph >/dev/null && '$bin' graph info mixed.mgraph --json | grep -q '\"joints\":22'"
+  # Retargeting (docs/retarget.md): chains and per-bone agreement in --json.
+  "$bin" clip retarget "$mocap/cmu_bvh_131/131_01.bvh" -o rt.bvh --json >rt.json
+  check "clip retarget: every bone agrees with the source (mean cos >= 0.97), contacts kept" python3 -c "import json,sys; d=json.load(open('rt.json')); sys.exit(0 if d['chains']['thigh_l']=='LeftHip' and all(b['mean_cos']>=0.97 for b in d['bones']) and d['contacts']['max_drift_m']<0.003 else 1)"
+  check "clip retarget writes the puppet's skeleton" bash -c "'$bin' clip info rt.bvh --json | grep -q '\"joints\":22'"
+  printf '[retarget]\nknee = "LeftLeg"\n' >bad_map.toml
+  expect_error "clip retarget: bad map file" 2 "bad_map.toml:2: retarget.knee: unknown role" "$bin" clip retarget "$mocap/cmu_bvh_131/131_01.bvh" --map bad_map.toml -o x.bvh
 fi
 
 echo "cli: $passes passed, $failures failed"
