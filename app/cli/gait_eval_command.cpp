@@ -50,7 +50,8 @@ std::string sweep_json(const SweepSummary& s) {
                                 json::quote(f.problem));
         for (const SweepMetric& metric : kSweepMetrics)
             failures += fmt::format(",{}:{}", json::quote(metric.name), json::number(f.metrics.*metric.value));
-        failures += "}";
+        failures += fmt::format(",\"fastest_joint\":{},\"fastest_joint_tick\":{}}}", json::quote(f.metrics.fastest_joint),
+                                f.metrics.fastest_joint_tick);
     }
     return fmt::format("{{\"seed\":{},\"cases\":{},\"passed\":{},\"failed\":{},\"ticks\":{},\"worst\":{{{}}},"
                        "\"by_ground\":{{{}}},\"failures\":[{}]}}\n",
@@ -70,7 +71,8 @@ void print_sweep_text(const SweepSummary& s) {
                    s.cases_by_ground[g]);
     fmt::print(" passed\n");
     for (const SweepFailure& f : s.failures)
-        fmt::print("  FAILED {}: {}\n      {}\n", f.case_id, f.problem, f.description);
+        fmt::print("  FAILED {}: {}\n      {}\n      fastest joint: {} at tick {}\n", f.case_id, f.problem, f.description,
+                   f.metrics.fastest_joint, f.metrics.fastest_joint_tick);
 }
 
 int gait_sweep_command(const GaitEvalOptions& o) {
@@ -123,12 +125,13 @@ int gait_eval_command(const GaitEvalOptions& o) {
     if (o.json) {
         fmt::print("{{\"terrain\":{},\"program\":{},\"motion_source\":{},\"graph\":{},\"ticks\":{},\"foot_skate_mm\":{},"
                    "\"penetration_mm\":{},\"speed_error_pct\":{},\"speed_expectation\":{},\"speed_windows\":{},"
-                   "\"max_joint_speed_deg_s\":{},\"obstacle_penetration_mm\":{},\"turn_time_s\":{},\"turns\":{},"
+                   "\"max_joint_speed_deg_s\":{},\"fastest_joint\":{},\"fastest_joint_tick\":{},\"obstacle_penetration_mm\":{},\"turn_time_s\":{},\"turns\":{},"
                    "\"steps\":{},\"flight_phases\":{},\"final_hash\":\"{:016x}\",\"limits_ok\":{}}}\n",
                    json::quote(config.terrain_name), json::quote(o.program), json::quote(m.motion_source),
                    with_graph ? json::quote(graph_name) : std::string("null"), m.ticks, json::number(m.foot_skate_mm),
                    json::number(m.penetration_mm), json::number(m.speed_error_pct), json::quote(m.speed_expectation),
-                   m.speed_windows, json::number(m.max_joint_speed_deg_s), json::number(m.obstacle_penetration_mm),
+                   m.speed_windows, json::number(m.max_joint_speed_deg_s), json::quote(m.fastest_joint), m.fastest_joint_tick,
+                   json::number(m.obstacle_penetration_mm),
                    turn_time_json(m.turn_time_s, !m.turns.empty()), turns_json(m), m.steps, m.flight_phases, m.final_hash,
                    with_graph ? "null" : checked.ok() ? "true" : "false");
     } else {

@@ -303,9 +303,21 @@ void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, 
     f.path_length = build_arc_length_table(keys);
 }
 
+// How much of the mid-swing reach allowance (kFullLegReachShare over the
+// planted reach) a swing at progress u has: 4u(1 − u), 0 at lift-off and
+// landing; a re-aimed swing starts with what its predecessor had (carry) and
+// lets it go over its progress, so re-aiming never takes the allowance away in
+// one tick (that dropped the pelvis by centimetres in a tick and snapped both
+// knees).
+float swing_reach_bump(float progress, float carry) {
+    const float u = clampf(progress, 0.0f, 1.0f);
+    return maxf(4.0f * u * (1.0f - u), carry * (1.0f - u));
+}
+
 // Starts (or re-aims) a swing from where the foot is now toward a planted target.
 void begin_swing(FootState& f, const Placement& target, const Terrain& terrain, const GaitRig& rig, const GaitConfig& c,
                  float blend, float lift_phase, float timed_rate) {
+    f.reach_carry = f.swinging ? swing_reach_bump(f.progress, f.reach_carry) : 0.0f;
     f.start = f.ankle;
     f.start_rotation = f.rotation;
     f.start_ground = f.ground;
@@ -568,7 +580,6 @@ constexpr float kFullActivitySpeed = 1.0f;         // m/s at which bob and arm s
 constexpr float kPelvisBaseRateScale = 1.5f;       // the pelvis base follows the ground this much faster than interpolation_rate
 constexpr float kFullLegReachShare = 0.995f;       // mid-swing the hip may be this share of thigh + shin from the ankle
 constexpr float kMinHipDropShareSq = 0.09f;        // the hip stays at least 0.3 of the reach (squared: 0.09) above the ankle
-constexpr float kMidSwingBump = 4.0f;              // 4·u·(1 − u): 0 at lift-off and landing, 1 mid-swing
 constexpr float kEarlyLiftPhase = 0.05f;          // … at most this much of a cycle before its duty factor
 constexpr float kEarlyLiftReachShare = 0.9f;      // a planted foot this share of the leg reach behind its hip lifts
 constexpr float kEarlyLiftStanceShare = 0.95f;    // … or this share of kStanceReachM (before the root pivots on it)
@@ -884,8 +895,7 @@ PelvisLimits pelvis_limits(const GaitState& g, const GaitTick& t, vec3 pelvis) {
         }
         // The planted reach at lift-off and landing, the full leg mid-swing, so
         // neither lifting nor landing changes the limit in one tick.
-        const float u = clampf(f.progress, 0.0f, 1.0f);
-        const float swing_reach = rig.leg_reach + (full_reach - rig.leg_reach) * (kMidSwingBump * u * (1.0f - u));
+        const float swing_reach = rig.leg_reach + (full_reach - rig.leg_reach) * swing_reach_bump(f.progress, f.reach_carry);
         limit.hard = minf(limit.hard, f.ankle.y + hip_drop(dx * dx + dz * dz, swing_reach * swing_reach));
         const float rate = f.timed_rate > 0.0f
                                ? f.timed_rate

@@ -39,8 +39,9 @@ void hash_gait(XXH64_state_t* h, const GaitState& g) {
         hash_quat(h, f.start_rotation);
         hash_vec(h, f.target);
         hash_quat(h, f.target_rotation);
-        const float scalars[8] = {f.ground, f.start_ground, f.target_ground, f.progress, f.fraction, f.lift_phase, f.timed_rate, f.lift_scale};
-        hash_floats(h, scalars, 8);
+        const float scalars[9] = {f.ground, f.start_ground, f.target_ground, f.progress, f.fraction, f.lift_phase, f.timed_rate, f.lift_scale,
+                                  f.reach_carry};
+        hash_floats(h, scalars, 9);
         hash_floats(h, f.path_height.data(), f.path_height.size());
         hash_floats(h, f.path_length.length.data(), f.path_length.length.size());
         hash_ints(h, {f.swinging, f.replanned});
