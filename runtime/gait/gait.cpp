@@ -213,12 +213,25 @@ float monotone_tangent(const Value& v, int i) {
     return before * after > 0.0f ? 2.0f * before * after / (before + after) : 0.0f;
 }
 
-// The swing path's Hermite keys from its heights: key i at s = key_fraction(i),
-// position (0, height, key_reach(i) · distance); both coordinates have monotone
-// tangents, so the foot never moves back or overshoots a key's height.
-void swing_path_keys(const FootState& f, std::array<HermiteKey, kSwingPathKeys>& keys) {
-    constexpr int n = kSwingPathKeys;
+// How far the swing travels across, for its path: the ankle's horizontal
+// distance, or, when the foot mostly turns (a closing step, a step in place),
+// the horizontal chord its toe tip sweeps turning from its lift-off to its
+// landing rotation, if that is longer. The path's arc length then gives the
+// turn its share of the swing's time: measured by the ankle alone, a foot that
+// lifts, turns 20° over a few millimetres and sets down would turn in one tick.
+float swing_travel(const FootState& f, const GaitRig& rig) {
     const float distance = horizontal_distance(f.start, f.target);
+    const vec3 tip = sole_offsets(rig)[2];
+    const float sweep = horizontal_distance(quat_rotate(f.start_rotation, tip), quat_rotate(f.target_rotation, tip));
+    return maxf(distance, sweep);
+}
+
+// The swing path's Hermite keys from its heights: key i at s = key_fraction(i),
+// position (0, height, key_reach(i) · travel); both coordinates have monotone
+// tangents, so the foot never moves back or overshoots a key's height.
+void swing_path_keys(const FootState& f, const GaitRig& rig, std::array<HermiteKey, kSwingPathKeys>& keys) {
+    constexpr int n = kSwingPathKeys;
+    const float distance = swing_travel(f, rig);
     const auto height = [&](std::size_t k) { return f.path_height[k]; };
     const auto along = [&](std::size_t k) { return key_reach(static_cast<int>(k)) * distance; };
     for (int i = 0; i < n; ++i) {
@@ -299,7 +312,7 @@ void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, 
         f.path_height[k] = maxf(shaped, floor);
     }
     std::array<HermiteKey, kSwingPathKeys> keys{};
-    swing_path_keys(f, keys);
+    swing_path_keys(f, rig, keys);
     f.path_length = build_arc_length_table(keys);
 }
 
@@ -333,12 +346,12 @@ void evaluate_swing(FootState& f, int foot, const GaitConfig& c, const GaitRig& 
     const vec3 shape = blended_swing(rig, blend, u);  // (sideways, lift, share of the path)
     const float share = clampf(shape.z, 0.0f, 1.0f);
     std::array<HermiteKey, kSwingPathKeys> keys{};
-    swing_path_keys(f, keys);
+    swing_path_keys(f, rig, keys);
     const std::span<const HermiteKey> path(keys.data(), keys.size());
     const float total = f.path_length.total();
     const float s = total > 1e-6f ? clampf(time_at_arc_length(path, f.path_length, share * total), 0.0f, 1.0f) : share;
-    const vec3 on_path = sample_hermite(path, s).position;  // (0, height, distance along the step)
-    const float distance = horizontal_distance(f.start, f.target);
+    const vec3 on_path = sample_hermite(path, s).position;  // (0, height, travel along the step)
+    const float distance = swing_travel(f, rig);
     const float reach = distance > 1e-6f ? clampf(on_path.z / distance, 0.0f, 1.0f) : s;
     f.fraction = reach;
     vec3 p = lerp(f.start, f.target, reach) + left * (side_sign(foot) * shape.x * f.lift_scale);
