@@ -240,6 +240,23 @@ void swing_path_keys(const FootState& f, const GaitRig& rig, std::array<HermiteK
     }
 }
 
+constexpr float kNoGroundM = 1e9f;     // m: below any ground
+constexpr float kSweepSampleM = 0.01f;  // m between ground samples along a sole point's way from key to key
+
+// The highest ground (less a toes-down foot's drop, as at the keys) that the
+// sole points pass over between two neighbouring keys, each point moving
+// straight from where it is at one key (ankle a0, rotation q0) to where it is
+// at the next: a box corner or a riser edge between two keys' samples is seen.
+float ground_between_keys(const Terrain& terrain, const GaitRig& rig, vec3 a0, quat q0, vec3 a1, quat q1) {
+    float h = -kNoGroundM;
+    for (const vec3& o : sole_offsets(rig)) {
+        const vec3 p0 = quat_rotate(q0, o), p1 = quat_rotate(q1, o);
+        const float drop = maxf(-p0.y, -p1.y) - rig.ankle_height;
+        h = maxf(h, max_height_along(terrain, a0.x + p0.x, a0.z + p0.z, a1.x + p1.x, a1.z + p1.z, kSweepSampleM) + drop);
+    }
+    return h;
+}
+
 constexpr float kRiserM = 0.01f;             // m: ground this much above the foot's spot next to it is a riser
 constexpr float kLiftOffClearanceM = 0.005f;  // m: the straight lift-off and set-down away from risers
 
@@ -279,6 +296,13 @@ void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, 
             }
         }
         ground[static_cast<std::size_t>(i)] = h;
+    }
+    for (int i = 0; i + 1 < n; ++i) {
+        const std::size_t k = static_cast<std::size_t>(i);
+        const float between = ground_between_keys(terrain, rig, lerp(f.start, f.target, key_reach(i)), rotation[k],
+                                                  lerp(f.start, f.target, key_reach(i + 1)), rotation[k + 1]);
+        ground[k] = maxf(ground[k], between);
+        ground[k + 1] = maxf(ground[k + 1], between);
     }
     // The prototype's lift against the fraction of the step it has covered:
     // (fraction, lift) sampled evenly in swing progress, fraction rising.
