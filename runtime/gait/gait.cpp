@@ -213,18 +213,69 @@ float monotone_tangent(const Value& v, int i) {
     return before * after > 0.0f ? 2.0f * before * after / (before + after) : 0.0f;
 }
 
-// The swing path's Hermite keys from its heights: key i at s = key_fraction(i),
-// position (0, height, key_reach(i) · distance); both coordinates have monotone
-// tangents, so the foot never moves back or overshoots a key's height.
-void swing_path_keys(const FootState& f, std::array<HermiteKey, kSwingPathKeys>& keys) {
-    constexpr int n = kSwingPathKeys;
+// How far the swing travels across, for its path: the ankle's horizontal
+// distance, or, when the foot mostly turns (a closing step, a step in place),
+// the horizontal chord its toe tip sweeps turning from its lift-off to its
+// landing rotation, if that is longer. The path's arc length then gives the
+// turn its share of the swing's time: measured by the ankle alone, a foot that
+// lifts, turns 20° over a few millimetres and sets down would turn in one tick.
+float swing_travel(const FootState& f, const GaitRig& rig) {
     const float distance = horizontal_distance(f.start, f.target);
+    const vec3 tip = sole_offsets(rig)[2];
+    const float sweep = horizontal_distance(quat_rotate(f.start_rotation, tip), quat_rotate(f.target_rotation, tip));
+    return maxf(distance, sweep);
+}
+
+// The swing path's Hermite keys from its heights: key i at s = key_fraction(i),
+// position (0, height, key_reach(i) · travel); both coordinates have monotone
+// tangents, so the foot never moves back or overshoots a key's height.
+void swing_path_keys(const FootState& f, const GaitRig& rig, std::array<HermiteKey, kSwingPathKeys>& keys) {
+    constexpr int n = kSwingPathKeys;
+    const float distance = swing_travel(f, rig);
     const auto height = [&](std::size_t k) { return f.path_height[k]; };
     const auto along = [&](std::size_t k) { return key_reach(static_cast<int>(k)) * distance; };
     for (int i = 0; i < n; ++i) {
         const std::size_t k = static_cast<std::size_t>(i);
         keys[k] = {key_fraction(i), vec3(0.0f, height(k), along(k)), vec3(0.0f, monotone_tangent(height, i), monotone_tangent(along, i))};
     }
+}
+
+constexpr float kNoGroundM = 1e9f;     // m: below any ground
+constexpr float kSweepSampleM = 0.01f;  // m between ground samples along a sole point's way from key to key
+constexpr int kSwayProbes = 24;         // samples of the prototype's sway
+constexpr float kSwaySlackM = 0.002f;   // m added to the sway's band
+
+// The highest ground (less a toes-down foot's drop, as at the keys) that the
+// sole points pass over between two neighbouring keys, each point moving
+// straight from where it is at one key (ankle a0, rotation q0) to where it is
+// at the next, and the same lines shifted by `sway` either side (the swing's
+// sideways sway, evaluate_swing): a box corner or a riser edge between two
+// keys' samples, or just beside them, is seen.
+float ground_between_keys(const Terrain& terrain, const GaitRig& rig, vec3 a0, quat q0, vec3 a1, quat q1, vec3 sway) {
+    float h = -kNoGroundM;
+    for (const vec3& o : sole_offsets(rig)) {
+        const vec3 p0 = quat_rotate(q0, o), p1 = quat_rotate(q1, o);
+        const float drop = maxf(-p0.y, -p1.y) - rig.ankle_height;
+        for (const float side : {0.0f, 1.0f, -1.0f}) {
+            const vec3 b0 = a0 + p0 + sway * side, b1 = a1 + p1 + sway * side;
+            h = maxf(h, max_height_along(terrain, b0.x, b0.z, b1.x, b1.z, kSweepSampleM) + drop);
+        }
+    }
+    return h;
+}
+
+// The most the swing sways sideways (the blended prototype's x, scaled as in
+// evaluate_swing), across the step: perpendicular to it, or to the landing
+// foot's facing for a step in place.
+vec3 swing_sway(const FootState& f, const GaitRig& rig, float blend) {
+    float most = 0.0f;
+    for (int j = 0; j <= kSwayProbes; ++j)
+        most = maxf(most, std::fabs(blended_swing(rig, blend, static_cast<float>(j) / static_cast<float>(kSwayProbes)).x));
+    vec3 along(f.target.x - f.start.x, 0.0f, f.target.z - f.start.z);
+    if (length3(along) < kSweepSampleM) along = quat_rotate(f.target_rotation, vec3(0.0f, 0.0f, 1.0f));
+    along.y = 0.0f;
+    const vec3 unit = normalize3(along, vec3(0.0f, 0.0f, 1.0f));
+    return vec3(unit.z, 0.0f, -unit.x) * (most * f.lift_scale + kSwaySlackM);
 }
 
 constexpr float kRiserM = 0.01f;             // m: ground this much above the foot's spot next to it is a riser
@@ -267,6 +318,14 @@ void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, 
         }
         ground[static_cast<std::size_t>(i)] = h;
     }
+    const vec3 sway = swing_sway(f, rig, blend);
+    for (int i = 0; i + 1 < n; ++i) {
+        const std::size_t k = static_cast<std::size_t>(i);
+        const float between = ground_between_keys(terrain, rig, lerp(f.start, f.target, key_reach(i)), rotation[k],
+                                                  lerp(f.start, f.target, key_reach(i + 1)), rotation[k + 1], sway);
+        ground[k] = maxf(ground[k], between);
+        ground[k + 1] = maxf(ground[k + 1], between);
+    }
     // The prototype's lift against the fraction of the step it has covered:
     // (fraction, lift) sampled evenly in swing progress, fraction rising.
     constexpr int m = 24;
@@ -299,7 +358,7 @@ void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, 
         f.path_height[k] = maxf(shaped, floor);
     }
     std::array<HermiteKey, kSwingPathKeys> keys{};
-    swing_path_keys(f, keys);
+    swing_path_keys(f, rig, keys);
     f.path_length = build_arc_length_table(keys);
 }
 
@@ -345,12 +404,12 @@ void evaluate_swing(FootState& f, int foot, const GaitConfig& c, const GaitRig& 
     const vec3 shape = blended_swing(rig, blend, u);  // (sideways, lift, share of the path)
     const float share = clampf(shape.z, 0.0f, 1.0f);
     std::array<HermiteKey, kSwingPathKeys> keys{};
-    swing_path_keys(f, keys);
+    swing_path_keys(f, rig, keys);
     const std::span<const HermiteKey> path(keys.data(), keys.size());
     const float total = f.path_length.total();
     const float s = total > 1e-6f ? clampf(time_at_arc_length(path, f.path_length, share * total), 0.0f, 1.0f) : share;
-    const vec3 on_path = sample_hermite(path, s).position;  // (0, height, distance along the step)
-    const float distance = horizontal_distance(f.start, f.target);
+    const vec3 on_path = sample_hermite(path, s).position;  // (0, height, travel along the step)
+    const float distance = swing_travel(f, rig);
     const float reach = distance > 1e-6f ? clampf(on_path.z / distance, 0.0f, 1.0f) : s;
     f.fraction = reach;
     vec3 p = lerp(f.start, f.target, reach) + left * (side_sign(foot) * shape.x * f.lift_scale);

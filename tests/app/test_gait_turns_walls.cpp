@@ -155,6 +155,25 @@ TEST_CASE("generated: turns of 0-180 degrees both ways at random speeds meet eve
     }
 }
 
+TEST_CASE("generated: turns of 45-180 degrees from a walk and from a full run on flat ground meet the turn times, no stance foot slides",
+          "[gait][turns]") {
+    // Walk: stick 0.5 (0.93 m/s); run: full stick (3 m/s). Angles drawn either way.
+    Rng rng{1305};
+    for (int i = 0; i < 16; ++i) {
+        const double deflection = i % 2 == 0 ? 0.5 : 1.0;
+        const double angle = rng.uniform(45.0, 180.0) * (rng.next() % 2 == 0 ? 1.0 : -1.0);
+        const std::string program = turn_program(deflection, angle);
+        INFO("case " << i << ":\n" << program);
+        const GaitMetrics m = run(program);
+        check_limits(m, true);
+        REQUIRE(m.turns.size() == 2);
+        const TurnTime& t = m.turns[1];
+        INFO("turn of " << t.angle_deg << " deg: " << t.time_s << " s");
+        CHECK(t.time_s >= 0.0);
+        CHECK(t.time_s < turn_time_target(t.angle_deg));
+    }
+}
+
 TEST_CASE("generated: the stick spun at random rates and speeds meets every limit", "[gait][turns][!mayfail]") {
     Rng rng{1302};
     for (int i = 0; i < 40; ++i) {
