@@ -14,7 +14,7 @@ void velocity_axis(float& x, float& v, float& a, float goal, float y, float dt) 
     const float j0 = v - goal;
     const float j1 = a + j0 * y;
     const float e = approx_negexp(y * dt);
-    x = e * (((-j1) / (y * y)) * dt + ((-j0 - j1 * dt) / y)) + (j1 / (y * y)) + j0 / y + goal * dt + x;
+    x = e * (((-j1) / (y * y)) + ((-j0 - j1 * dt) / y)) + (j1 / (y * y)) + j0 / y + goal * dt + x;
     v = e * (j0 + j1 * dt) + goal;
     a = e * (a - j1 * y * dt);
 }
