@@ -123,6 +123,18 @@ const KeySpec kKeys[] = {
     {"motion", "crossfade_s", &SimConfig::motion_crossfade_s, 0.0, 5.0, "a live change of motion source cross-fades over this long (s)"},
     {"motion", "feet_release_s", &SimConfig::feet_release_s, 0.0, 2.0, "graph_feet: a lifted foot eases from its pin back to the clip's foot (s)"},
     {"motion", "feet_terrain_rate", &SimConfig::feet_terrain_rate, 0.1, 100.0, "graph_feet: how fast the body follows the ground height (1/s)"},
+    // [motion_matching] (docs/motion-matching.md): feature weights, then the controller.
+    {"motion_matching", "foot_position_weight", &SimConfig::matching_foot_position_weight, 0.0, 100.0, "weight of both feet's positions in the root frame"},
+    {"motion_matching", "foot_velocity_weight", &SimConfig::matching_foot_velocity_weight, 0.0, 100.0, "weight of both feet's velocities"},
+    {"motion_matching", "hips_velocity_weight", &SimConfig::matching_hips_velocity_weight, 0.0, 100.0, "weight of the hips' velocity"},
+    {"motion_matching", "trajectory_position_weight", &SimConfig::matching_trajectory_position_weight, 0.0, 100.0, "weight of the future root positions (1/3, 2/3, 1 s)"},
+    {"motion_matching", "trajectory_facing_weight", &SimConfig::matching_trajectory_facing_weight, 0.0, 100.0, "weight of the future facings (1/3, 2/3, 1 s)"},
+    {"motion_matching", "search_interval_s", &SimConfig::matching_search_interval_s, 0.005, 2.0, "the database is searched at least this often (s)"},
+    {"motion_matching", "search_threshold_m", &SimConfig::matching_search_threshold_m, 0.01, 10.0, "… and whenever the desired trajectory is this far from the playing frame's (m)"},
+    {"motion_matching", "inertialization_s", &SimConfig::matching_inertialization_s, 0.01, 2.0, "a jump's pose offsets decay to zero over this long (s)"},
+    {"motion_matching", "velocity_halflife_s", &SimConfig::matching_velocity_halflife_s, 0.01, 2.0, "halflife of the spring carrying the desired velocity toward the stick's (s)"},
+    {"motion_matching", "facing_halflife_s", &SimConfig::matching_facing_halflife_s, 0.01, 2.0, "halflife of the spring carrying the desired facing toward the stick's (s)"},
+    {"motion_matching", "correction_halflife_s", &SimConfig::matching_correction_halflife_s, 0.01, 2.0, "halflife of the pull of the character's root toward the desired trajectory (s)"},
     // [gait] (docs/gait.md); the prototypes are [gait.walk] and [gait.run], below.
     {"gait", "pelvis_height", &SimConfig::gait_pelvis_height, 0.3, 2.0, "hip height above the mean foot ground while stepping (m)"},
     {"gait", "step_length_multiplier", &SimConfig::step_length_multiplier, 0.05, 2.0, "step length = multiplier · sqrt(speed)"},
@@ -144,7 +156,7 @@ const KeySpec kKeys[] = {
 };
 
 // [motion] source, a string-valued key; the names index MotionSourceSetting.
-constexpr const char* kMotionSourceNames[] = {"auto", "gait", "graph", "graph_feet"};
+constexpr const char* kMotionSourceNames[] = {"auto", "gait", "graph", "graph_feet", "matching"};
 // [timing] interpolation, the other one (not the tick's: never serialized); the names index Interpolation.
 constexpr const char* kInterpolationNames[] = {"interpolate", "extrapolate", "latest"};
 constexpr const char* kInterpolationDoc =
@@ -361,7 +373,7 @@ std::vector<ConfigKeyInfo> config_schema() {
     std::vector<ConfigKeyInfo> out;
     for (const KeySpec& k : kKeys)
         out.push_back({k.table, k.key, is_integer(k.field) ? "integer" : "float", k.min, k.max, k.doc});
-    out.push_back({"motion", "source", "string", 0, 0, "what poses the puppet: auto, gait, graph or graph_feet"});
+    out.push_back({"motion", "source", "string", 0, 0, "what poses the puppet: auto, gait, graph, graph_feet or matching"});
     out.push_back({"timing", "interpolation", "string", 0, 0, kInterpolationDoc});
     for (const std::string_view b : kButtonNames)
         out.push_back({"motion_graph.buttons", std::string(b), "string", 0.0, 0.0, "graph label played when the button is pressed, \"\" for none"});
@@ -443,7 +455,7 @@ void apply_motion_source(SimConfig& config, const toml::node& node, const std::s
         }
     throw ConfigError(file, line_of(node), "motion.source",
                       (s ? "'" + s->get() + "' is not a motion source" : std::string("expected a string")) +
-                          " (expected \"auto\", \"gait\", \"graph\" or \"graph_feet\")");
+                          " (expected \"auto\", \"gait\", \"graph\", \"graph_feet\" or \"matching\")");
 }
 
 void apply_interpolation(TimingConfig& timing, const toml::node& node, const std::string& file) {

@@ -37,7 +37,7 @@ struct ConfigKeyInfo {
 // Every key the configuration accepts, in the order the effective text lists them.
 std::vector<ConfigKeyInfo> config_schema();
 
-// "auto", "gait", "graph" or "graph_feet", as [motion] source spells it.
+// "auto", "gait", "graph", "graph_feet" or "matching", as [motion] source spells it.
 std::string motion_source_name(MotionSourceSetting source);
 // [timing] interpolation: "interpolate", "extrapolate" or "latest".
 std::string interpolation_name(Interpolation mode);

@@ -174,6 +174,7 @@ bool foot_in_stance(const PuppetState& s, int foot) {
     // graph_feet: a foot is planted while its pin holds it (not merely while the
     // clip says contact: a pin let go for slipping is not a stance).
     if (s.motion_source == kSourceGraphFeet) return s.feet.feet[static_cast<std::size_t>(foot)].contact == 1;
+    if (s.motion_source == kSourceMatching) return s.matching_feet.feet[static_cast<std::size_t>(foot)].contact == 1;
     if (s.motion_source == kSourceGraph) return (s.graph.contacts & (foot == 0 ? kContactLeft : kContactRight)) != 0;
     return s.gait.feet[static_cast<std::size_t>(foot)].swinging == 0;
 }
@@ -231,7 +232,7 @@ MeasuredPuppet drive_with_graph(Simulation& sim, std::shared_ptr<const MotionGra
     p.graph_full_speed_m_s = static_cast<double>(config.graph_full_stick_speed) *
                              (g.leg_length > 0.0f ? g.leg_length : 1.0) * sim.metres_per_unit();
     const std::int32_t source = sim.state().motion_source;
-    m.motion_source = source == kSourceGraphFeet ? "graph_feet" : source == kSourceGraph ? "graph" : "gait";
+    m.motion_source = source == kSourceMatching ? "matching" : source == kSourceGraphFeet ? "graph_feet" : source == kSourceGraph ? "graph" : "gait";
     m.speed_expectation = "graph full_stick_speed x leg_metres x stick deflection";
     return p;
 }
@@ -261,7 +262,22 @@ public:
         measure_obstacles(s);
         measure_hold_speeds(k, s);
         measure_turns(k, s);
+        measure_issue14(k, s);
         previous_ = s;
+    }
+
+    // distance, start latency, heading error and pop ratio (issue 14).
+    void finish_issue14() {
+        m_.start_latency_s = 0.0;
+        for (double latency : latencies_) m_.start_latency_s = latency < 0.0 || m_.start_latency_s < 0.0 ? -1.0 : std::max(m_.start_latency_s, latency);
+        if (start_tick_ >= 0) m_.start_latency_s = -1.0;  // a start still waiting at the end never got there
+        m_.heading_error_deg = heading_samples_ > 0 ? heading_sum_ / heading_samples_ : 0.0;
+        if (!moves_.empty()) {
+            std::vector<double> sorted = moves_;
+            std::sort(sorted.begin(), sorted.end());
+            const double p95 = sorted[sorted.size() * 95 / 100];
+            m_.pop_ratio = p95 > 0.0 ? sorted.back() / p95 : 0.0;
+        }
     }
 
     // The slowest turn (one that never got there counts as slowest).
@@ -363,6 +379,40 @@ private:
         }
     }
 
+    void measure_issue14(std::uint64_t k, const PuppetState& s) {
+        if (k % sample_every_ == 0) {
+            const double dx = s.root_position.x - distance_sample_.x, dz = s.root_position.z - distance_sample_.z;
+            if (k > 0) m_.distance_m += std::sqrt(dx * dx + dz * dz);
+            distance_sample_ = s.root_position;
+        }
+        double worst = 0.0;
+        for (int j = 0; j < s.joint_count; ++j) {
+            const std::size_t i = static_cast<std::size_t>(j);
+            worst = std::max(worst, static_cast<double>(glm::length(s.model_positions[i] - previous_.model_positions[i])));
+        }
+        moves_.push_back(worst);
+        const double sx = ticks_[k].left_x / static_cast<double>(kStickScale);
+        const double sy = ticks_[k].left_y / static_cast<double>(kStickScale);
+        const double deflection = std::sqrt(sx * sx + sy * sy);
+        const bool pushed = stick_speed_fraction(static_cast<float>(deflection > 1.0 ? 1.0 : deflection), config_) > 0.0f;
+        const double speed = std::sqrt(static_cast<double>(s.velocity.x) * s.velocity.x + static_cast<double>(s.velocity.y) * s.velocity.y);
+        if (pushed && !stick_was_pushed_ && start_tick_ < 0 && speed < 0.5) start_tick_ = static_cast<std::int64_t>(k);
+        if (start_tick_ >= 0 && speed >= 0.5) {
+            latencies_.push_back(static_cast<double>(static_cast<std::int64_t>(k) + 1 - start_tick_) / config_.tick_rate_hz);
+            start_tick_ = -1;
+        } else if (start_tick_ >= 0 && !pushed) {
+            latencies_.push_back(-1.0);  // let go before it ever got going
+            start_tick_ = -1;
+        }
+        stick_was_pushed_ = pushed;
+        for (const Hold& hold : holds_) {
+            if (k < hold.first_tick + (hold.end_tick - hold.first_tick) / 2 || k >= hold.end_tick) continue;
+            const double want = det::atan2(hold.stick_x, -hold.stick_y);
+            heading_sum_ += std::fabs(det::wrap_angle(want - s.heading)) * det::kRadToDeg;
+            ++heading_samples_;
+        }
+    }
+
     void append_feet_csv_row(int i, const PuppetState& s, const FootPoints& fp, bool stance) {
         const FootState& f = s.gait.feet[static_cast<std::size_t>(i)];
         csv_ += fmt::format("{},{:.4f},{:.3f},{},{:.4f},{},{},{:.3f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f}", s.tick, s.gait.cycle_phase, s.gait.speed,
@@ -451,7 +501,32 @@ private:
     std::vector<vec3> last_sample_;
     const std::uint64_t sample_every_;
     std::string csv_;  // the feet CSV, when asked for
+    vec3 distance_sample_{0.0f};
+    std::vector<double> moves_, latencies_;
+    std::int64_t start_tick_ = -1;
+    bool stick_was_pushed_ = false;
+    double heading_sum_ = 0.0;
+    std::int64_t heading_samples_ = 0;
 };
+
+// The root path length of the gait alone over the same ticks and terrain (the
+// reference of distance_ratio_to_gait).
+double gait_distance(const SimConfig& config, const std::vector<TickInput>& ticks) {
+    SimConfig gait = config;
+    gait.motion_source = MotionSourceSetting::gait;
+    Simulation sim(gait);
+    const std::uint64_t every = static_cast<std::uint64_t>(config.tick_rate_hz / 4);
+    double distance = 0.0;
+    vec3 last = sim.state().root_position;
+    for (std::uint64_t k = 0; k < ticks.size(); ++k) {
+        sim.step(ticks[k]);
+        if (k % every != 0) continue;
+        const vec3 p = sim.state().root_position;
+        if (k > 0) distance += std::sqrt((p.x - last.x) * (p.x - last.x) + (p.z - last.z) * (p.z - last.z));
+        last = p;
+    }
+    return distance;
+}
 
 void write_feet_csv(const std::string& path, const std::string& csv) {
     std::FILE* out = std::fopen(path.c_str(), "wb");
@@ -480,6 +555,11 @@ GaitMetrics evaluate_gait(const SimConfig& config, const StickProgram& program, 
     }
     meter.finish_speed_error();
     meter.finish_turns();
+    meter.finish_issue14();
+    if (m.motion_source != "gait") {
+        const double reference = gait_distance(config, ticks);
+        m.distance_ratio_to_gait = reference > 0.0 ? m.distance_m / reference : 0.0;
+    }
     if (!feet_csv.empty()) write_feet_csv(feet_csv, meter.feet_csv());
     m.ticks = ticks.size();
     m.final_hash = hash_state(sim.state());

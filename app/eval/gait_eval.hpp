@@ -37,6 +37,12 @@ struct GaitMetrics {
     double obstacle_penetration_mm = 0.0;  // deepest joint or sole point inside an obstacle box
     std::vector<TurnTime> turns;         // every stick direction change of at least kMinTurnDeg
     double turn_time_s = 0.0;            // the slowest of them (time_s; < 0 when one never got there)
+    // Issue 14's measures, for every source (docs/motion-matching.md):
+    double distance_m = 0.0;             // root path length over the program (sampled every quarter second)
+    double distance_ratio_to_gait = 1.0; // distance_m over the gait's for the same program and terrain
+    double start_latency_s = 0.0;        // worst: stick pushed from rest → root speed ≥ 0.5 m/s (−1: never)
+    double heading_error_deg = 0.0;      // mean |stick direction − heading| over the second half of each moving hold
+    double pop_ratio = 0.0;              // largest per-tick joint move over its 95th percentile
     int steps = 0;                       // touchdowns seen in the sole heights
     int flight_phases = 0;               // intervals with both feet off the ground
     int speed_windows = 0;               // holds long enough to measure the speed over

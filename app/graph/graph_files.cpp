@@ -45,7 +45,8 @@ std::shared_ptr<const MotionGraph> load_graph_argument(const std::string& argume
                                                        const GraphBuildConfig& build) {
     if (argument.empty()) {
         const bool wants_graph = config.motion_source == MotionSourceSetting::graph ||
-                                 config.motion_source == MotionSourceSetting::graph_feet;
+                                 config.motion_source == MotionSourceSetting::graph_feet ||
+                                 config.motion_source == MotionSourceSetting::matching;
         if (!wants_graph) return nullptr;
         return std::make_shared<const MotionGraph>(build_default_motion_graph(config, build));
     }

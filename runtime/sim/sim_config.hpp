@@ -17,7 +17,7 @@ namespace marionette {
 
 // [motion] source: what poses the puppet. `automatic` is the motion graph when one
 // is attached (`--graph`), the gait otherwise.
-enum class MotionSourceSetting : std::int32_t { automatic = 0, gait = 1, graph = 2, graph_feet = 3 };
+enum class MotionSourceSetting : std::int32_t { automatic = 0, gait = 1, graph = 2, graph_feet = 3, matching = 4 };
 // [motion_graph.buttons]: the graph label a button plays on press ("" for none),
 // and where the value came from, for the error when the graph lacks the label.
 struct GraphButtonBinding {
@@ -78,8 +78,25 @@ struct MotionGraphConfig {
     std::array<GraphButtonBinding, kButtonCount> graph_buttons = default_graph_buttons();
 };
 
+// [motion_matching]: the motion-matching source (runtime/matching/, docs/motion-matching.md).
+struct MotionMatchingConfig {
+    // feature weights (each group normalised by its own standard deviation first)
+    float matching_foot_position_weight = 0.75f;
+    float matching_foot_velocity_weight = 1.0f;
+    float matching_hips_velocity_weight = 1.0f;
+    float matching_trajectory_position_weight = 1.0f;
+    float matching_trajectory_facing_weight = 1.5f;
+    // the controller
+    float matching_search_interval_s = 0.1f;
+    float matching_search_threshold_m = 0.15f;
+    float matching_inertialization_s = 0.25f;
+    float matching_velocity_halflife_s = 0.12f;
+    float matching_facing_halflife_s = 0.15f;
+    float matching_correction_halflife_s = 0.08f;
+};
+
 // Thread settings and graph build parameters are no part of it: the tick never
 // reads them (app/config/app_config.hpp holds them beside a SimConfig).
-struct SimConfig : TickConfig, GaitConfig, TerrainConfig, MotionSourceConfig, MotionGraphConfig {};
+struct SimConfig : TickConfig, GaitConfig, TerrainConfig, MotionSourceConfig, MotionGraphConfig, MotionMatchingConfig {};
 
 }  // namespace marionette

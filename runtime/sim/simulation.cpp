@@ -4,6 +4,7 @@
 #define XXH_STATIC_LINKING_ONLY
 #include <xxhash.h>
 
+#include <cmath>
 #include <initializer_list>
 #include <stdexcept>
 
@@ -74,6 +75,29 @@ void hash_graph(XXH64_state_t* h, std::int32_t source, const GraphControllerStat
         XXH64_update(h, w, sizeof w);
     }
 }
+// The matching controller's state and its feet, field by field.
+void hash_matching(XXH64_state_t* h, const MatchingState& m, const FootPlacementState& feet, size_t joints) {
+    hash_ints(h, {m.frame, m.contacts, feet.started, feet.feet[0].contact, feet.feet[1].contact});
+    const double world[3] = {m.world_angle, m.world_dx, m.world_dz};
+    XXH64_update(h, world, sizeof world);
+    const TrajectorySpring& sp = m.spring;
+    const float f[13] = {m.frame_time, sp.px, sp.pz, sp.vx, sp.vz, sp.ax, sp.az, sp.heading, sp.heading_rate,
+                         m.since_search, m.since_jump, m.last_cost, feet.body_offset};
+    hash_floats(h, f, 13);
+    const std::int64_t counters[2] = {m.searches, m.jumps};
+    XXH64_update(h, counters, sizeof counters);
+    for (size_t j = 0; j < joints && j < m.offset_rotation.size(); ++j) {
+        hash_quat(h, m.offset_rotation[j]);
+        hash_vec(h, m.offset_translation[j]);
+    }
+    for (const FootPin& p : feet.feet) {
+        hash_vec(h, p.pin);
+        hash_vec(h, p.placed);
+        hash_vec(h, p.clip_previous);
+        const float w[3] = {p.ground, p.release, p.plant};
+        hash_floats(h, w, 3);
+    }
+}
 }  // namespace
 
 void set_simulation_float_mode() {
@@ -110,6 +134,7 @@ std::int32_t resolve_motion_source(const SimConfig& config, bool graph_attached)
     switch (config.motion_source) {
         case MotionSourceSetting::gait: return kSourceGait;
         case MotionSourceSetting::graph_feet: return kSourceGraphFeet;
+        case MotionSourceSetting::matching: return kSourceMatching;
         case MotionSourceSetting::automatic:
         case MotionSourceSetting::graph: break;
     }
@@ -134,15 +159,19 @@ Outcome Simulation::retune(const SimConfig& next) {
     if (Outcome allowed = motion_source_allowed(next); !allowed.ok()) return allowed;
     const std::int32_t source = resolve_motion_source(next, graph_ != nullptr);
     const std::int32_t current = state_.motion_source;
+    const bool reweigh = matching_db_ && !(matching_weights(next) == matching_weights(config_));
     config_ = next;
     rig_ = make_gait_rig(config_);
+    if (matching_) matching_->set_config(matching_controller_config(config_));
+    if (reweigh) normalise_matching_database(*matching_db_, matching_weights(config_));
     if (source != current) begin_source_change(source);
     return Outcome::success();
 }
 
 Outcome Simulation::motion_source_allowed(const SimConfig& next) const {
-    const bool wants_graph =
-        next.motion_source == MotionSourceSetting::graph || next.motion_source == MotionSourceSetting::graph_feet;
+    const bool wants_graph = next.motion_source == MotionSourceSetting::graph ||
+                             next.motion_source == MotionSourceSetting::graph_feet ||
+                             next.motion_source == MotionSourceSetting::matching;
     if (!graph_ && wants_graph)
         return Outcome::failure("motion.source (no motion graph is attached: start with --graph, or with this source in the configuration)");
     const std::int32_t source = resolve_motion_source(next, graph_ != nullptr);
@@ -152,6 +181,8 @@ Outcome Simulation::motion_source_allowed(const SimConfig& next) const {
         return Outcome::failure("motion.source (the motion graph's skeleton is not the puppet's, so gait and graph cannot blend)");
     if (source == kSourceGraphFeet && !foot_rig_.valid)
         return Outcome::failure("motion.source (graph_feet: the motion graph names no foot joints with a knee and a hip)");
+    if (source == kSourceMatching && !matching_)
+        return Outcome::failure("motion.source (matching: the motion graph's skeleton is not the puppet's, or it has no walking clips with feet)");
     return Outcome::success();
 }
 
@@ -181,10 +212,21 @@ void Simulation::use_motion_graph(std::shared_ptr<const MotionGraph> graph, cons
     state_.motion_source = source;
     state_.joint_count = skeleton().joint_count();
     state_.graph = graph_controller_->initial_state();
+    attach_matching();
+    if (source == kSourceMatching && !matching_)
+        throw std::invalid_argument("motion.source matching: the motion graph's skeleton is not the puppet's, or it has no walking clips with feet");
     if (source == kSourceGait) return;
+    if (source == kSourceMatching) {
+        state_.matching = matching_->initial_state(vec3(0.0f), 0.0f);
+        state_.matching_active = 1;
+        step_matching(TickInput{}, 0.0f, matching_pose_);
+        place_feet(matching_pose_, 0.0f, matching_feet_pose_, state_.matching_feet, state_.matching.contacts);
+        output(matching_feet_pose_, source, 0.0f);
+        return;
+    }
     step_graph(TickInput{}, 0.0f, graph_pose_);
     if (source == kSourceGraphFeet) {
-        place_feet(graph_pose_, 0.0f, feet_pose_);
+        place_feet(graph_pose_, 0.0f, feet_pose_, state_.feet, state_.graph.contacts);
         output(feet_pose_, source, 0.0f);
     } else {
         output(graph_pose_, source, 0.0f);
@@ -206,13 +248,13 @@ void Simulation::step_graph(const TickInput& input, float dt, Pose& out) {
     expect_job_ran(LocalToModelJob{std::span<const int>(graph_->skeleton.parents), pose.local(), pose.model()}.run());
 }
 
-void Simulation::place_feet(const Pose& clip, float dt, Pose& out) {
+void Simulation::place_feet(const Pose& clip, float dt, Pose& out, FootPlacementState& feet, std::uint8_t contacts) {
     out = clip;
     const size_t n = static_cast<size_t>(graph_->joint_count());
-    const FootPlacementJob job{&state_.feet,
+    const FootPlacementJob job{&feet,
                                &foot_rig_,
                                &terrain_,
-                               state_.graph.contacts,
+                               contacts,
                                dt,
                                config_.feet_release_s,
                                config_.feet_terrain_rate,
@@ -285,7 +327,7 @@ void Simulation::output(const Pose& pose, std::int32_t source, float dt) {
     const size_t root = static_cast<size_t>(foot_rig_.root);
     const vec3 p = pose.model_positions[root];
     const vec2 before(s.root_position.x, s.root_position.z);
-    s.root_position = vec3(p.x, source == kSourceGraphFeet ? s.feet.body_offset : 0.0f, p.z);
+    s.root_position = vec3(p.x, source == kSourceGraphFeet ? s.feet.body_offset : (source == kSourceMatching ? s.matching_feet.body_offset : 0.0f), p.z);
     if (dt > 0.0f) s.velocity = (vec2(p.x, p.z) - before) / dt;
     s.heading = graph_heading(pose.model_rotations[root]);
 }
@@ -303,8 +345,9 @@ void Simulation::output_blend(const Pose& from, const Pose& to, float weight, fl
             return;
         }
         const size_t root = static_cast<size_t>(foot_rig_.root);
-        position = vec3(pose.model_positions[root].x, source == kSourceGraphFeet ? s.feet.body_offset : 0.0f,
-                        pose.model_positions[root].z);
+        const float body = source == kSourceGraphFeet ? s.feet.body_offset
+                                                      : (source == kSourceMatching ? s.matching_feet.body_offset : 0.0f);
+        position = vec3(pose.model_positions[root].x, body, pose.model_positions[root].z);
         heading = graph_heading(pose.model_rotations[root]);
     };
     vec3 p_from, p_to;
@@ -342,7 +385,12 @@ void Simulation::begin_source_change(std::int32_t source) {
         s.gait_root.position = vec3(p.x, s.gait.pelvis_base, p.z);
         s.gait_root.velocity = vec2(0.0f);
         s.gait_root.heading = s.heading;
-    } else if (current == kSourceGait) {
+    } else if (source == kSourceMatching) {
+        // Matching starts from where the puppet is, facing its way, its springs at rest.
+        matching_->place(s.matching, s.root_position, s.heading);
+        s.matching_feet = FootPlacementState{};
+        s.matching_active = 1;
+    } else if (current == kSourceGait || current == kSourceMatching) {
         // Re-place the graph's motion so its root is where the puppet is, facing its way.
         const size_t n = static_cast<size_t>(graph_->joint_count());
         const PoseSpans blend = blend_pose_.spans(n);
@@ -373,11 +421,21 @@ void Simulation::step(const TickInput& input) {
     const std::int32_t to = s.motion_source;
     const std::int32_t from = fading ? s.fade.from : to;
     // Every source in play advances (a fading one too, so its pose keeps moving).
-    if (to == kSourceGait || from == kSourceGait) step_gait(input, dt, gait_pose_);
-    if (to != kSourceGait || from != kSourceGait) step_graph(input, dt, graph_pose_);
-    if (to == kSourceGraphFeet || from == kSourceGraphFeet) place_feet(graph_pose_, dt, feet_pose_);
+    auto uses = [&](std::int32_t a, std::int32_t b) { return to == a || from == a || to == b || from == b; };
+    if (uses(kSourceGait, kSourceGait)) step_gait(input, dt, gait_pose_);
+    if (uses(kSourceGraph, kSourceGraphFeet)) step_graph(input, dt, graph_pose_);
+    if (uses(kSourceGraphFeet, kSourceGraphFeet)) place_feet(graph_pose_, dt, feet_pose_, s.feet, s.graph.contacts);
+    if (uses(kSourceMatching, kSourceMatching)) {
+        step_matching(input, dt, matching_pose_);
+        place_feet(matching_pose_, dt, matching_feet_pose_, s.matching_feet, s.matching.contacts);
+    }
     auto pose_of = [&](std::int32_t source) -> const Pose& {
-        return source == kSourceGait ? gait_pose_ : (source == kSourceGraph ? graph_pose_ : feet_pose_);
+        switch (source) {
+            case kSourceGait: return gait_pose_;
+            case kSourceGraph: return graph_pose_;
+            case kSourceGraphFeet: return feet_pose_;
+            default: return matching_feet_pose_;
+        }
     };
     if (!fading) {
         output(pose_of(to), to, dt);
@@ -421,6 +479,7 @@ std::uint64_t hash_state(const PuppetState& s) {
             hash_floats(h, weights, 3);
         }
     }
+    if (s.matching_active) hash_matching(h, s.matching, s.matching_feet, static_cast<size_t>(s.joint_count));
     const int n = s.joint_count < 0 ? 0 : (s.joint_count > kMaxJoints ? kMaxJoints : s.joint_count);
     for (int j = 0; j < n; ++j) {
         const size_t i = static_cast<size_t>(j);
@@ -432,6 +491,85 @@ std::uint64_t hash_state(const PuppetState& s) {
         hash_floats(h, v, 14);
     }
     return XXH64_digest(h);
+}
+
+}  // namespace marionette
+
+namespace marionette {
+
+MatchingWeights matching_weights(const SimConfig& c) {
+    MatchingWeights w;
+    w.foot_position = c.matching_foot_position_weight;
+    w.foot_velocity = c.matching_foot_velocity_weight;
+    w.hips_velocity = c.matching_hips_velocity_weight;
+    w.trajectory_position = c.matching_trajectory_position_weight;
+    w.trajectory_facing = c.matching_trajectory_facing_weight;
+    return w;
+}
+
+MatchingControllerConfig matching_controller_config(const SimConfig& c) {
+    MatchingControllerConfig m;
+    m.search_interval_s = c.matching_search_interval_s;
+    m.search_threshold_m = c.matching_search_threshold_m;
+    m.inertialization_s = c.matching_inertialization_s;
+    m.velocity_halflife_s = c.matching_velocity_halflife_s;
+    m.facing_halflife_s = c.matching_facing_halflife_s;
+    m.correction_halflife_s = c.matching_correction_halflife_s;
+    return m;
+}
+
+// The database from the attached graph's locomotion clips (labels walk, run,
+// idle, turn, stop; every clip when none has them), when the graph has the
+// puppet's skeleton and feet. Allocates: only when a graph is attached.
+void Simulation::attach_matching() {
+    if (!graph_matches_puppet_ || !foot_rig_.valid) return;
+    const MotionGraph& g = *graph_;
+    std::uint32_t locomotion = 0;
+    for (const char* label : {"walk", "run", "idle", "turn", "stop"})
+        if (const int b = g.label_index(label); b >= 0) locomotion |= 1u << b;
+    matching_clips_.clear();
+    for (const GraphClip& c : g.clips)
+        if (locomotion == 0 || (c.label_mask & locomotion) != 0) matching_clips_.push_back({c.first_frame, c.frame_count});
+    MatchingSource source;
+    source.parents = std::span<const int>(g.skeleton.parents);
+    source.rotations = g.rotations;
+    source.translations = g.translations;
+    source.contacts = g.contacts;
+    source.clips = matching_clips_;
+    source.frame_rate = g.frame_rate;
+    source.metres_per_unit = metres_per_unit_;
+    source.facing_offset = graph_controller_->facing_offset();
+    source.left_foot = g.left_foot;
+    source.right_foot = g.right_foot;
+    auto db = std::make_unique<MatchingDatabase>();
+    if (!build_matching_database(source, matching_weights(config_), *db).ok()) return;
+    matching_db_ = std::move(db);
+    matching_ = std::make_unique<MatchingController>(source, *matching_db_, matching_controller_config(config_));
+}
+
+// Stick → desired velocity and facing with the gait's own response (dead zone,
+// response curve, max_speed, slope slow-down), then the matching controller.
+void Simulation::step_matching(const TickInput& input, float dt, Pose& out) {
+    PuppetState& s = state_;
+    const float sx = static_cast<float>(input.left_x) / kStickScale;
+    const float sy = static_cast<float>(input.left_y) / kStickScale;
+    const float length = std::sqrt(sx * sx + sy * sy);
+    const float fraction = stick_speed_fraction(length < 1.0f ? length : 1.0f, config_);
+    MatchingInput in;
+    in.dt = dt;
+    in.goal.heading = s.matching.spring.heading;
+    if (fraction > 0.0f) {
+        const float dx = sx / length, dz = -sy / length;
+        in.goal.heading = static_cast<float>(det::atan2(dx, dz));
+        const float speed = ground_speed(terrain_, config_, fraction, s.matching.spring.px, s.matching.spring.pz, in.goal.heading);
+        in.goal.vx = dx * speed;
+        in.goal.vz = dz * speed;
+    }
+    const size_t n = static_cast<size_t>(graph_->joint_count());
+    const PoseSpans pose = out.spans(n);
+    const LocalPoseOutput local{pose.local_rotations, pose.local_translations};
+    expect_job_ran(dt > 0.0f ? matching_->step(s.matching, in, local) : matching_->pose(s.matching, local));
+    expect_job_ran(LocalToModelJob{std::span<const int>(graph_->skeleton.parents), pose.local(), pose.model()}.run());
 }
 
 }  // namespace marionette

@@ -6,12 +6,14 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "runtime/anim/clip.hpp"
 #include "runtime/errors/outcome.hpp"
 #include "runtime/anim/foot_placement.hpp"
 #include "runtime/gait/gait.hpp"
 #include "runtime/graph/graph_controller.hpp"
+#include "runtime/matching/matching_controller.hpp"
 #include "runtime/sim/sim_config.hpp"
 #include "runtime/ground/terrain.hpp"
 #include "runtime/sim/tick_input.hpp"
@@ -22,7 +24,7 @@ inline constexpr int kMaxJoints = 64;
 
 // What poses the puppet (PuppetState::motion_source); SimConfig's [motion] source
 // resolves to one of these (resolve_motion_source).
-enum MotionSource : std::int32_t { kSourceGait = 0, kSourceGraph = 1, kSourceGraphFeet = 2 };
+enum MotionSource : std::int32_t { kSourceGait = 0, kSourceGraph = 1, kSourceGraphFeet = 2, kSourceMatching = 3 };
 
 // A change of motion source in progress: the old source keeps running and its
 // pose is blended out over `duration` seconds.
@@ -59,6 +61,9 @@ struct PuppetState {
     GaitRoot gait_root{};
     GraphControllerState graph{};      // the graph controller's state
     FootPlacementState feet{};         // graph_feet: pins and body height
+    std::int32_t matching_active = 0;  // 1 once motion matching has posed the puppet (the two below are then hashed)
+    MatchingState matching{};          // the motion-matching controller's state
+    FootPlacementState matching_feet{};  // matching: pins and body height
     std::array<quat, kMaxJoints> local_rotations{};
     std::array<vec3, kMaxJoints> local_translations{};
     std::array<quat, kMaxJoints> model_rotations{};   // world space
@@ -105,6 +110,9 @@ public:
     // True when the attached graph has the puppet's joints (names and parents), so
     // the gait and the graph can blend into each other.
     bool graph_matches_puppet() const { return graph_matches_puppet_; }
+    // The motion-matching database built from the attached graph's locomotion
+    // clips (null without a graph, or when its skeleton is not the puppet's).
+    const MatchingDatabase* matching_database() const { return matching_db_.get(); }
     // Metres per graph unit of the attached graph's translations (1 without one).
     double metres_per_unit() const { return metres_per_unit_; }
     // Ok when retune would take the [motion] source of `next`, otherwise why not
@@ -130,7 +138,9 @@ private:
     void step_gait(const TickInput& input, float dt, Pose& out);
     void pose_gait(Pose& out) const;
     void step_graph(const TickInput& input, float dt, Pose& out);
-    void place_feet(const Pose& clip, float dt, Pose& out);
+    void place_feet(const Pose& clip, float dt, Pose& out, FootPlacementState& feet, std::uint8_t contacts);
+    void step_matching(const TickInput& input, float dt, Pose& out);
+    void attach_matching();
     void begin_source_change(std::int32_t source);
     float graph_heading(quat root_rotation) const;
     void output(const Pose& pose, std::int32_t source, float dt);
@@ -147,9 +157,16 @@ private:
     FootPlacementRig foot_rig_;
     bool graph_matches_puppet_ = false;
     bool skeleton_from_graph_ = false;
-    Pose gait_pose_, graph_pose_, feet_pose_, blend_pose_;  // scratch, rebuilt from the state every tick
+    std::vector<MatchingClipRange> matching_clips_;
+    std::unique_ptr<MatchingDatabase> matching_db_;
+    std::unique_ptr<MatchingController> matching_;
+    Pose gait_pose_, graph_pose_, feet_pose_, blend_pose_, matching_pose_, matching_feet_pose_;  // scratch, rebuilt from the state every tick
     PuppetState state_;
 };
+
+// The motion-matching parts of a configuration.
+MatchingWeights matching_weights(const SimConfig& config);
+MatchingControllerConfig matching_controller_config(const SimConfig& config);
 
 // The MotionSource a configuration asks for, given whether a graph is attached
 // (`auto` and the graph sources fall back to the gait without one).

@@ -1,0 +1,115 @@
+#pragma once
+// The motion-matching database (Clavet, "Motion Matching and The Road to
+// Next-Gen Animation", GDC 2016; Holden et al., "Learned Motion Matching", 2020):
+// every frame of the locomotion clips is a place the character may jump to, and
+// each is described by a feature vector in its own root frame (the ground point
+// under the root joint, turned to the frame's facing):
+//   - both feet's positions and velocities,
+//   - the hips' (root joint's) velocity,
+//   - where the root will be 1/3, 2/3 and 1 s later and which way it will face.
+// Each feature group is normalised by its mean and one standard deviation for
+// the whole group, then multiplied by its weight ([motion_matching] weights), so
+// a squared distance between two vectors weighs the groups as configured.
+// Built once, outside the tick (allocates); the search (matching_search.hpp) and
+// the controller only read it. Deterministic: double accumulation in frame
+// order, owned atan2, no BLAS.
+//
+// The source frames are a plain view of clip data (MatchingSource): the
+// puppet's own clips through the motion graph today, retargeted clips later, as
+// long as they share the puppet's joint layout.
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "runtime/errors/outcome.hpp"
+#include "runtime/math/math.hpp"
+
+namespace marionette {
+
+inline constexpr int kMatchFeatureCount = 27;
+inline constexpr int kMatchTrajectoryPoints = 3;           // at 1/3, 2/3 and 1 s
+inline constexpr int kMatchSmallBox = 16;                 // frames per small bounding box
+inline constexpr int kMatchLargeBox = 64;                 // frames per large bounding box (4 small)
+
+// Feature groups: [begin, end) in the feature vector.
+enum MatchFeatureGroup : int {
+    kMatchFootPosition = 0,   // left xyz, right xyz
+    kMatchFootVelocity,       // left xyz, right xyz
+    kMatchHipsVelocity,       // xyz
+    kMatchTrajectoryPosition, // x z at each point
+    kMatchTrajectoryFacing,   // facing x z at each point
+    kMatchGroupCount
+};
+inline constexpr std::array<int, kMatchGroupCount + 1> kMatchGroupBegin = {0, 6, 12, 15, 21, 27};
+
+// [motion_matching] feature weights (docs/config.md).
+struct MatchingWeights {
+    float foot_position = 0.75f;
+    float foot_velocity = 1.0f;
+    float hips_velocity = 1.0f;
+    float trajectory_position = 1.0f;
+    float trajectory_facing = 1.5f;
+    float of(int group) const;
+    bool operator==(const MatchingWeights&) const = default;
+};
+
+// One clip of the source: frames [first_frame, first_frame + frame_count).
+struct MatchingClipRange {
+    std::int32_t first_frame = 0;
+    std::int32_t frame_count = 0;
+};
+
+// Where the frames come from: local rotations and translations of `joint_count`
+// joints per frame, frame after frame, the root (joint 0) in clip coordinates.
+struct MatchingSource {
+    std::span<const int> parents;                 // topological order, joint 0 the root
+    std::span<const quat> rotations;              // [frame * joints + joint]
+    std::span<const vec3> translations;           // same layout, source units
+    std::span<const std::uint8_t> contacts;       // per frame: bit 0 left foot, bit 1 right foot
+    std::span<const MatchingClipRange> clips;     // the clips that enter the database, in order
+    double frame_rate = 30.0;
+    float metres_per_unit = 1.0f;
+    double facing_offset = 0.0;                   // yaw from the root's +Z to the clips' forward
+    int left_foot = -1, right_foot = -1;          // ankle joints
+    int joint_count() const { return static_cast<int>(parents.size()); }
+};
+
+struct MatchingDatabase {
+    std::int32_t frame_count = 0;
+    std::int32_t joint_count = 0;
+    double frame_rate = 30.0;
+    std::array<std::int32_t, kMatchTrajectoryPoints> trajectory_frames{};  // frames ahead of each point
+    std::vector<std::int32_t> source_frame;      // database frame → source frame
+    std::vector<std::int32_t> clip_end;          // database frame → one past its clip's last database frame
+    std::vector<std::uint8_t> searchable;        // 1: a search may jump here (enough clip left)
+    std::vector<float> features;                 // [frame * kMatchFeatureCount + k], normalised and weighted
+    std::vector<float> raw_features;             // the same before normalisation (metres, m/s, unit facings)
+    std::array<float, kMatchFeatureCount> mean{};
+    std::array<float, kMatchFeatureCount> inv_scale{};  // weight / group standard deviation
+    // Bounds of the searchable frames' features over runs of frames: box b covers
+    // frames [b·size, (b+1)·size); a box with no searchable frame is empty (lo > hi).
+    std::vector<float> small_lo, small_hi, large_lo, large_hi;  // [box * kMatchFeatureCount + k]
+
+    const float* frame_features(int frame) const { return features.data() + static_cast<size_t>(frame) * kMatchFeatureCount; }
+    const float* frame_raw(int frame) const { return raw_features.data() + static_cast<size_t>(frame) * kMatchFeatureCount; }
+    // raw → normalised, as the frames were.
+    void normalise(std::span<const float> raw, std::span<float> out) const;
+};
+
+// The features of every frame of `source`'s clips, normalised with `weights`.
+// Fails (naming what is wrong) for an empty or inconsistent source, a foot joint
+// missing, a weight that is negative or not finite, or a feature that is not finite.
+Outcome build_matching_database(const MatchingSource& source, const MatchingWeights& weights, MatchingDatabase& out);
+
+// Recomputes the normalisation, the normalised features and the boxes from
+// raw_features (after build, or after frames were appended): the API a database
+// of several sources (the puppet's clips, retargeted clips) is assembled with.
+void normalise_matching_database(MatchingDatabase& db, const MatchingWeights& weights);
+
+// World vector → the root frame of a root facing `heading` ((sin h, 0, cos h) is +Z there).
+inline vec3 to_root_frame(vec3 v, double sin_h, double cos_h) {
+    return vec3(static_cast<float>(cos_h * v.x - sin_h * v.z), v.y, static_cast<float>(sin_h * v.x + cos_h * v.z));
+}
+
+}  // namespace marionette
