@@ -242,40 +242,19 @@ void swing_path_keys(const FootState& f, const GaitRig& rig, std::array<HermiteK
 
 constexpr float kNoGroundM = 1e9f;     // m: below any ground
 constexpr float kSweepSampleM = 0.01f;  // m between ground samples along a sole point's way from key to key
-constexpr int kSwayProbes = 24;         // samples of the prototype's sway
-constexpr float kSwaySlackM = 0.002f;   // m added to the sway's band
 
 // The highest ground (less a toes-down foot's drop, as at the keys) that the
 // sole points pass over between two neighbouring keys, each point moving
 // straight from where it is at one key (ankle a0, rotation q0) to where it is
-// at the next, and the same lines shifted by `sway` either side (the swing's
-// sideways sway, evaluate_swing): a box corner or a riser edge between two
-// keys' samples, or just beside them, is seen.
-float ground_between_keys(const Terrain& terrain, const GaitRig& rig, vec3 a0, quat q0, vec3 a1, quat q1, vec3 sway) {
+// at the next: a box corner or a riser edge between two keys' samples is seen.
+float ground_between_keys(const Terrain& terrain, const GaitRig& rig, vec3 a0, quat q0, vec3 a1, quat q1) {
     float h = -kNoGroundM;
     for (const vec3& o : sole_offsets(rig)) {
         const vec3 p0 = quat_rotate(q0, o), p1 = quat_rotate(q1, o);
         const float drop = maxf(-p0.y, -p1.y) - rig.ankle_height;
-        for (const float side : {0.0f, 1.0f, -1.0f}) {
-            const vec3 b0 = a0 + p0 + sway * side, b1 = a1 + p1 + sway * side;
-            h = maxf(h, max_height_along(terrain, b0.x, b0.z, b1.x, b1.z, kSweepSampleM) + drop);
-        }
+        h = maxf(h, max_height_along(terrain, a0.x + p0.x, a0.z + p0.z, a1.x + p1.x, a1.z + p1.z, kSweepSampleM) + drop);
     }
     return h;
-}
-
-// The most the swing sways sideways (the blended prototype's x, scaled as in
-// evaluate_swing), across the step: perpendicular to it, or to the landing
-// foot's facing for a step in place.
-vec3 swing_sway(const FootState& f, const GaitRig& rig, float blend) {
-    float most = 0.0f;
-    for (int j = 0; j <= kSwayProbes; ++j)
-        most = maxf(most, std::fabs(blended_swing(rig, blend, static_cast<float>(j) / static_cast<float>(kSwayProbes)).x));
-    vec3 along(f.target.x - f.start.x, 0.0f, f.target.z - f.start.z);
-    if (length3(along) < kSweepSampleM) along = quat_rotate(f.target_rotation, vec3(0.0f, 0.0f, 1.0f));
-    along.y = 0.0f;
-    const vec3 unit = normalize3(along, vec3(0.0f, 0.0f, 1.0f));
-    return vec3(unit.z, 0.0f, -unit.x) * (most * f.lift_scale + kSwaySlackM);
 }
 
 constexpr float kRiserM = 0.01f;             // m: ground this much above the foot's spot next to it is a riser
@@ -318,11 +297,10 @@ void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, 
         }
         ground[static_cast<std::size_t>(i)] = h;
     }
-    const vec3 sway = swing_sway(f, rig, blend);
     for (int i = 0; i + 1 < n; ++i) {
         const std::size_t k = static_cast<std::size_t>(i);
         const float between = ground_between_keys(terrain, rig, lerp(f.start, f.target, key_reach(i)), rotation[k],
-                                                  lerp(f.start, f.target, key_reach(i + 1)), rotation[k + 1], sway);
+                                                  lerp(f.start, f.target, key_reach(i + 1)), rotation[k + 1]);
         ground[k] = maxf(ground[k], between);
         ground[k + 1] = maxf(ground[k + 1], between);
     }
