@@ -227,6 +227,18 @@ void swing_path_keys(const FootState& f, std::array<HermiteKey, kSwingPathKeys>&
     }
 }
 
+// The most the walk or the run prototype swings a foot sideways (m, at lift scale 1).
+constexpr int kSideSamples = 24;
+float max_swing_side(const GaitRig& rig) {
+    float side = 0.0f;
+    for (int j = 0; j <= kSideSamples; ++j) {
+        const float u = static_cast<float>(j) / static_cast<float>(kSideSamples);
+        side = maxf(side, maxf(std::fabs(eval_keys(rig.walk.swing_foot, rig.walk.swing_count, u).x),
+                               std::fabs(eval_keys(rig.run.swing_foot, rig.run.swing_count, u).x)));
+    }
+    return side;
+}
+
 constexpr float kRiserM = 0.01f;             // m: ground this much above the foot's spot next to it is a riser
 constexpr float kLiftOffClearanceM = 0.005f;  // m: the straight lift-off and set-down away from risers
 
@@ -247,10 +259,17 @@ void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, 
     std::array<quat, n> rotation{};
     for (int i = 0; i < n; ++i) rotation[static_cast<std::size_t>(i)] = swing_rotation(f, key_reach(i));
     const std::array<vec3, 3> sole = sole_offsets(rig);
+    // The foot swings out sideways by the prototype's x (along the root's left
+    // as it is then, which a turn changes): the ground under the ankle counts
+    // within that distance along both axes of the ground.
+    const float side = max_swing_side(rig) * f.lift_scale;
     std::array<float, n> ground{};
     for (int i = 0; i < n; ++i) {
         const vec3 a = lerp(f.start, f.target, key_reach(i));
         float h = query_ground(terrain, a.x, a.z).height;
+        if (side > 0.0f)
+            for (const vec2& d : {vec2(side, 0.0f), vec2(-side, 0.0f), vec2(0.0f, side), vec2(0.0f, -side)})
+                h = maxf(h, query_ground(terrain, a.x + d.x, a.z + d.y).height);
         const quat turns[3] = {rotation[static_cast<std::size_t>(i > 0 ? i - 1 : 0)], rotation[static_cast<std::size_t>(i)],
                                rotation[static_cast<std::size_t>(i + 1 < n ? i + 1 : n - 1)]};
         for (const quat& q : turns) {
@@ -341,7 +360,10 @@ void evaluate_swing(FootState& f, int foot, const GaitConfig& c, const GaitRig& 
     const float distance = horizontal_distance(f.start, f.target);
     const float reach = distance > 1e-6f ? clampf(on_path.z / distance, 0.0f, 1.0f) : s;
     f.fraction = reach;
-    vec3 p = lerp(f.start, f.target, reach) + left * (side_sign(foot) * shape.x * f.lift_scale);
+    // The sideways swing fades out over the straight lift-off and set-down, so
+    // the foot leaves and reaches its spots straight up and down.
+    const float out = clampf(minf(reach, 1.0f - reach) / kHoldRotationShare, 0.0f, 1.0f);
+    vec3 p = lerp(f.start, f.target, reach) + left * (side_sign(foot) * shape.x * f.lift_scale * out);
     p.y = on_path.y;
     f.ankle = p;
     f.rotation = swing_rotation(f, reach);
