@@ -250,7 +250,7 @@ public:
         for (int i = 0; i < 2; ++i)
             stance_anchor_[i] = sim.state().model_positions[static_cast<std::size_t>(puppet.feet[i].ankle)];
         if (feet_csv)
-            csv_ = "tick,phase,speed,mode,pelvis_y,foot,swinging,progress,ankle_x,ankle_y,ankle_z,target_x,target_z,ankle_clear,sole_clear,ball_clear,tip_clear\n";
+            csv_ = "tick,phase,speed,mode,pelvis_y,foot,swinging,progress,ankle_x,ankle_y,ankle_z,target_x,target_z,ankle_clear,sole_clear,ball_clear,tip_clear,plan_x,plan_y,plan_z\n";
     }
 
     // After tick k (0-based) has run.
@@ -423,7 +423,7 @@ private:
             if (p_index < fp.count) csv_ += fmt::format(",{:.4f}", p.y - query_ground(terrain_, p.x, p.z).height);
             else csv_ += ",";
         }
-        csv_ += "\n";
+        csv_ += fmt::format(",{:.4f},{:.4f},{:.4f}\n", f.ankle.x, f.ankle.y, f.ankle.z);
     }
 
     void count_flight_phase() {

@@ -257,6 +257,18 @@ float ground_between_keys(const Terrain& terrain, const GaitRig& rig, vec3 a0, q
     return h;
 }
 
+// The most the walk or the run prototype swings a foot sideways (m, at lift scale 1).
+constexpr int kSideSamples = 24;
+float max_swing_side(const GaitRig& rig) {
+    float side = 0.0f;
+    for (int j = 0; j <= kSideSamples; ++j) {
+        const float u = static_cast<float>(j) / static_cast<float>(kSideSamples);
+        side = maxf(side, maxf(std::fabs(eval_keys(rig.walk.swing_foot, rig.walk.swing_count, u).x),
+                               std::fabs(eval_keys(rig.run.swing_foot, rig.run.swing_count, u).x)));
+    }
+    return side;
+}
+
 constexpr float kRiserM = 0.01f;             // m: ground this much above the foot's spot next to it is a riser
 constexpr float kLiftOffClearanceM = 0.005f;  // m: the straight lift-off and set-down away from risers
 
@@ -277,10 +289,17 @@ void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, 
     std::array<quat, n> rotation{};
     for (int i = 0; i < n; ++i) rotation[static_cast<std::size_t>(i)] = swing_rotation(f, key_reach(i));
     const std::array<vec3, 3> sole = sole_offsets(rig);
+    // The foot swings out sideways by the prototype's x (along the root's left
+    // as it is then, which a turn changes): the ground under the ankle counts
+    // within that distance along both axes of the ground.
+    const float side = max_swing_side(rig) * f.lift_scale;
     std::array<float, n> ground{};
     for (int i = 0; i < n; ++i) {
         const vec3 a = lerp(f.start, f.target, key_reach(i));
         float h = query_ground(terrain, a.x, a.z).height;
+        if (side > 0.0f)
+            for (const vec2& d : {vec2(side, 0.0f), vec2(-side, 0.0f), vec2(0.0f, side), vec2(0.0f, -side)})
+                h = maxf(h, query_ground(terrain, a.x + d.x, a.z + d.y).height);
         const quat turns[3] = {rotation[static_cast<std::size_t>(i > 0 ? i - 1 : 0)], rotation[static_cast<std::size_t>(i)],
                                rotation[static_cast<std::size_t>(i + 1 < n ? i + 1 : n - 1)]};
         for (const quat& q : turns) {
@@ -390,7 +409,10 @@ void evaluate_swing(FootState& f, int foot, const GaitConfig& c, const GaitRig& 
     const float distance = swing_travel(f, rig);
     const float reach = distance > 1e-6f ? clampf(on_path.z / distance, 0.0f, 1.0f) : s;
     f.fraction = reach;
-    vec3 p = lerp(f.start, f.target, reach) + left * (side_sign(foot) * shape.x * f.lift_scale);
+    // The sideways swing fades out over the straight lift-off and set-down, so
+    // the foot leaves and reaches its spots straight up and down.
+    const float out = clampf(minf(reach, 1.0f - reach) / kHoldRotationShare, 0.0f, 1.0f);
+    vec3 p = lerp(f.start, f.target, reach) + left * (side_sign(foot) * shape.x * f.lift_scale * out);
     p.y = on_path.y;
     f.ankle = p;
     f.rotation = swing_rotation(f, reach);
@@ -610,6 +632,7 @@ constexpr float kLatestReaimProgress = 0.6f;       // a swing further along keep
 constexpr float kStanceReachM = 0.42f;             // m: the root keeps each planted foot this close to its hip, horizontally
 constexpr std::int32_t kMaxReaims = 3;             // a swing re-aims at most this often (the stick turning on)
 constexpr float kMinReaimShiftM = 0.06f;           // m: a new target closer than this to the old one is not taken
+constexpr float kStrandedLandingM = 0.5f;          // m: a landing spot this far from its hip at landing re-aims at any progress
 constexpr float kStopStaggerM = 0.05f;             // m: feet further apart along the heading close up when stopping
 constexpr float kMinClosingStepS = 0.25f;          // s: the closing step takes at least this long
 constexpr float kClosingStepStretch = 1.5f;        // … and otherwise this many times stop_transition_s
@@ -778,18 +801,43 @@ Placement aim_swing(const GaitState& g, const GaitTick& t, vec3 root, int i, flo
     return place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, heading_frame(facing).forward);
 }
 
-// A swing re-aims (up to kMaxReaims times, early in the swing) when the stick changed the landing spot a lot.
+// The swing's progress per second: at its own rate after a stop, else with the
+// cycle's phase (over what was left of it at lift-off), but never slower than a
+// kShortestSwing swing.
+float swing_rate(const FootState& f, const GaitTick& t) {
+    return f.timed_rate > 0.0f ? f.timed_rate
+                               : minf(t.dphase / t.dt / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), 1.0f / kShortestSwing);
+}
+
+// Where a swing's hip will be when it lands, if the root keeps its speed and heading.
+vec3 hip_at_landing(const FootState& f, const GaitState& g, const GaitTick& t, vec3 root, int i) {
+    const float remaining = maxf(0.0f, 1.0f - f.progress) / swing_rate(f, t);
+    return root + t.h.left * (side_sign(i) * t.rig.hip_half_width) + t.h.forward * (g.speed * remaining);
+}
+
+// A swing re-aims (up to kMaxReaims times, early in the swing) when the stick
+// changed the landing spot a lot. A swing whose landing spot the root has left
+// behind (a sharp turn or a turn in place starting late in the swing: the spot
+// more than kStrandedLandingM from where its hip will be) re-aims at any
+// progress, however often it already did, when that brings the spot closer:
+// landing there would take the leg out of reach (the pelvis sinks to reach it,
+// the planted foot is dragged).
 void reaim_if_command_changed(GaitState& g, const GaitTick& t, vec3 root, int i) {
     FootState& f = g.feet[static_cast<std::size_t>(i)];
     const bool command_changed =
         std::fabs(g.commanded_speed - f.planned_speed) > kReaimSpeedChange ||
         std::fabs(det::wrap_angle(static_cast<double>(t.desired_heading) - f.planned_heading)) > kReaimHeadingChangeRad;
-    const bool may_reaim = g.mode == GaitMode::stepping && command_changed && f.replanned < kMaxReaims && f.timed_rate == 0.0f &&
-                           f.progress < kLatestReaimProgress;
+    const bool stepping = g.mode == GaitMode::stepping && f.timed_rate == 0.0f;
+    const vec3 hip_then = hip_at_landing(f, g, t, root, i);
+    const float gap = horizontal_distance(f.target, hip_then);
+    const bool stranded = stepping && gap > kStrandedLandingM;
+    const bool may_reaim =
+        stepping && ((command_changed && f.replanned < kMaxReaims && f.progress < kLatestReaimProgress) || stranded);
     if (!may_reaim) return;
     const float psi = foot_phase(g.cycle_phase, i);
     const Placement p = aim_swing(g, t, root, i, psi);
-    if (horizontal_distance(p.ankle, f.target) > kMinReaimShiftM) {
+    const bool closer = !stranded || horizontal_distance(p.ankle, hip_then) < gap - kMinReaimShiftM;
+    if (closer && horizontal_distance(p.ankle, f.target) > kMinReaimShiftM) {
         const float ground = f.ground;
         begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
         f.start_ground = ground;
@@ -934,11 +982,7 @@ PelvisLimits pelvis_limits(const GaitState& g, const GaitTick& t, vec3 pelvis) {
         // neither lifting nor landing changes the limit in one tick.
         const float swing_reach = rig.leg_reach + (full_reach - rig.leg_reach) * swing_reach_bump(f.progress, f.reach_carry);
         limit.hard = minf(limit.hard, f.ankle.y + hip_drop(dx * dx + dz * dz, swing_reach * swing_reach));
-        const float rate = f.timed_rate > 0.0f
-                               ? f.timed_rate
-                               : minf(t.dphase / t.dt / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), 1.0f / kShortestSwing);
-        const float remaining = maxf(0.0f, 1.0f - f.progress) / rate;
-        const vec3 hip_then = hip + t.h.forward * (g.speed * remaining);
+        const vec3 hip_then = hip_at_landing(f, g, t, pelvis, i);
         const float tx = f.target.x - hip_then.x, tz = f.target.z - hip_then.z;
         limit.soft = minf(limit.soft, f.target.y + hip_drop(tx * tx + tz * tz, reach2));
     }

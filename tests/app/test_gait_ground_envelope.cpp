@@ -185,8 +185,9 @@ GaitMetrics check_case(Ground kind, std::uint64_t seed) {
 constexpr int kCasesPerKind = 12;
 
 // Generated seeds (of the 100 per kind of the wider sweep) that do not meet
-// every limit yet — mostly max joint speed, a few skate on steep slopes and
-// heightfields, one penetration: they run in the "[!mayfail]" test below, which
+// every limit yet — max joint speed on stairs and one curb (the slope and
+// heightfield seeds that skated, entered the ground or spun a joint meet every
+// limit since stranded swings re-aim, and are kept as regressions): they run in the "[!mayfail]" test below, which
 // reports them without failing the run, until the gait meets them; then they
 // move back into the must-pass set. docs/gait.md lists them.
 struct KnownFailure {
@@ -195,11 +196,7 @@ struct KnownFailure {
 };
 constexpr KnownFailure kKnownFailures[] = {
     // stairs
-    {Ground::stairs, 4}, {Ground::stairs, 6}, {Ground::stairs, 10}, {Ground::stairs, 11}, {Ground::stairs, 13}, {Ground::stairs, 15}, {Ground::stairs, 21}, {Ground::stairs, 27}, {Ground::stairs, 37}, {Ground::stairs, 40}, {Ground::stairs, 44}, {Ground::stairs, 52}, {Ground::stairs, 54}, {Ground::stairs, 78}, {Ground::stairs, 86}, {Ground::stairs, 89}, {Ground::stairs, 93}, {Ground::stairs, 95},
-    // slope
-    {Ground::slope, 4}, {Ground::slope, 23}, {Ground::slope, 28}, {Ground::slope, 33}, {Ground::slope, 35}, {Ground::slope, 37}, {Ground::slope, 47}, {Ground::slope, 51}, {Ground::slope, 53}, {Ground::slope, 60}, {Ground::slope, 61}, {Ground::slope, 69}, {Ground::slope, 70}, {Ground::slope, 75}, {Ground::slope, 76}, {Ground::slope, 84}, {Ground::slope, 90}, {Ground::slope, 95}, {Ground::slope, 100},
-    // heightfield
-    {Ground::heightfield, 4}, {Ground::heightfield, 25}, {Ground::heightfield, 28}, {Ground::heightfield, 32}, {Ground::heightfield, 56}, {Ground::heightfield, 60}, {Ground::heightfield, 73}, {Ground::heightfield, 89}, {Ground::heightfield, 91},
+    {Ground::stairs, 4}, {Ground::stairs, 6}, {Ground::stairs, 10}, {Ground::stairs, 11}, {Ground::stairs, 13}, {Ground::stairs, 15}, {Ground::stairs, 21}, {Ground::stairs, 27}, {Ground::stairs, 40}, {Ground::stairs, 44}, {Ground::stairs, 54}, {Ground::stairs, 78}, {Ground::stairs, 86}, {Ground::stairs, 89}, {Ground::stairs, 93}, {Ground::stairs, 95},
     // curb
     {Ground::curb, 74},
 };
@@ -233,15 +230,15 @@ void check_kind(Ground kind, const char* name, std::initializer_list<std::uint64
 }  // namespace
 
 TEST_CASE("gait ground envelope: generated stairs, up and down, at any angle to 60 degrees", "[gait_ground]") {
-    check_kind(Ground::stairs, "stairs", {});
+    check_kind(Ground::stairs, "stairs", {37, 52});
 }
 
 TEST_CASE("gait ground envelope: generated ramps and hillsides to 30 degrees, at any heading", "[gait_ground]") {
-    check_kind(Ground::slope, "ramps and hillsides", {});
+    check_kind(Ground::slope, "ramps and hillsides", {23, 28, 33, 35, 37, 47, 51, 53, 60, 61, 69, 70, 75, 76, 84, 90, 95, 100});
 }
 
 TEST_CASE("gait ground envelope: generated heightfields with 30 cm of relief", "[gait_ground]") {
-    check_kind(Ground::heightfield, "heightfields", {});
+    check_kind(Ground::heightfield, "heightfields", {25, 28, 32, 56, 60, 73, 89, 91});
 }
 
 TEST_CASE("gait ground envelope: generated curbs and ledges to 0.35 m", "[gait_ground]") {
