@@ -1,4 +1,4 @@
-// `marionette clip info` and `marionette clip fk`.
+// `marionette clip info` and `marionette clip fk` (fill and fill-eval: fill_commands.cpp).
 #include <fmt/format.h>
 
 #include <cstdio>
@@ -108,6 +108,7 @@ void register_clip_commands(CLI::App& app, int& exit_code) {
     fk->add_option("--frame", o->frame, "0-based frame index in the file")->required();
     on_parsed(info, exit_code, [o] { return clip_info_command(*o); });
     on_parsed(fk, exit_code, [o] { return clip_fk_command(*o); });
+    register_clip_fill_commands(clip, exit_code);
 }
 
 }  // namespace marionette
