@@ -281,15 +281,22 @@ void apply_graph(Clip& clip, const FillGap& g, const FillDatabase& db, const std
         for (size_t k = 0; k < hidden.size(); ++k) {
             const size_t j = static_cast<size_t>(hidden[k]);
             quat filled = quat_normalize(sum[static_cast<size_t>(f - g.first) * hidden.size() + k]);
-            const auto carried = [&](int known, int previous, int steps) {
+            // The velocity over up to 4 known frames (a one-frame capture glitch must
+            // not be multiplied by the ease's length), carried at most 0.3 rad.
+            const auto carried = [&](int known, int direction, int steps) {
+                int span = 1;
+                while (span < 4 && known + direction * (span + 1) >= 0 && known + direction * (span + 1) < clip.frame_count) ++span;
                 const quat q1 = pick(clip, known, hidden[k]);
-                const quat delta = quat_mul(quat_conjugate(pick(clip, previous, hidden[k])), q1);
-                return quat_mul(q1, quat_slerp(quat_identity(), delta, static_cast<float>(steps)));
+                const quat delta = quat_mul(quat_conjugate(pick(clip, known + direction * span, hidden[k])), q1);
+                double t = static_cast<double>(steps) / span;
+                const double angle = quat_angle_between(quat_identity(), delta) * t;
+                if (angle > 0.3) t *= 0.3 / angle;
+                return quat_mul(q1, quat_slerp(quat_identity(), delta, static_cast<float>(t)));
             };
             if (left_velocity && dl <= ease)
-                filled = quat_slerp(carried(g.first - 1, g.first - 2, dl), filled, smoothstep01(dl / (ease + 1.0)));
+                filled = quat_slerp(carried(g.first - 1, -1, dl), filled, smoothstep01(dl / (ease + 1.0)));
             if (right_velocity && dr <= ease)
-                filled = quat_slerp(carried(g.last + 1, g.last + 2, dr), filled, smoothstep01(dr / (ease + 1.0)));
+                filled = quat_slerp(carried(g.last + 1, +1, dr), filled, smoothstep01(dr / (ease + 1.0)));
             out[j] = weight >= 1.0f ? filled : quat_slerp(out[j], filled, weight);
         }
     }

@@ -175,13 +175,15 @@ TEST_CASE("fill: unknown joints, out-of-range frames, the root and other skeleto
     // The evaluation refuses the same way, naming the clip.
     Clip a = walker_clip("a", 0, 60), b = walker_clip("b", 0, 60);
     b.skeleton.joint_names[3] = "lelbow";
-    CHECK_THAT(import_message([&] { (void)evaluate_fill({a, b}, {"a.bvh", "b.bvh"}, FillEvalOptions{"left_arm"}); }),
+    FillEvalOptions eo;
+    eo.hide = "left_arm";
+    CHECK_THAT(import_message([&] { (void)evaluate_fill({a, b}, {"a.bvh", "b.bvh"}, eo); }),
                Catch::Contains("b.bvh") && Catch::Contains("until retargeting exists"));
 }
 
 TEST_CASE("fill: groups resolve on the CMU skeleton", "[fill]") {
     const std::string dir = test::mocap_dir();
-    if (dir.empty()) SKIP("no shared mocap folder");
+    if (dir.empty()) return;  // skipped without the shared data (fails under CI=true)
     const Skeleton s = import_asf_skeleton(test::read_text_file(dir + "/cmu_amc_16/16.asf"), "16.asf");
     const auto hidden_names = [&](const char* spec) {
         std::string out;
@@ -242,7 +244,7 @@ void check_targets(const char* group, const std::vector<double>& gaps, int trial
 // target (graph ≤ ½ slerp from 1 s); both legs and both arms beat slerp at every
 // length but not by half (docs/fill.md, "Where it stands").
 TEST_CASE("fill: on the CMU subject-16 clips graph beats slerp; one leg meets the half-error target", "[fill]") {
-    if (test::mocap_dir().empty()) SKIP("no shared mocap folder");
+    if (test::mocap_dir().empty()) return;  // skipped without the shared data (fails under CI=true)
     check_targets("left_leg", {0.25, 1.0, 2.0}, 2, true, true);
     check_targets("legs", {0.25, 1.0, 2.0}, 2, false, false);
     check_targets("arms", {0.25, 1.0, 2.0}, 2, false, true);
@@ -252,6 +254,6 @@ TEST_CASE("fill: on the CMU subject-16 clips graph beats slerp; one leg meets th
 // `marionette_graph_tests "[.fill-targets]"`; legs and arms miss the half-error
 // target today, docs/fill.md).
 TEST_CASE("fill: the issue's targets for legs, arms and one leg at every gap length", "[.fill-targets]") {
-    if (test::mocap_dir().empty()) SKIP("no shared mocap folder");
+    if (test::mocap_dir().empty()) return;  // skipped without the shared data (fails under CI=true)
     for (const char* group : {"legs", "arms", "left_leg"}) check_targets(group, {0.25, 0.5, 1.0, 2.0, 4.0}, 3, true, true);
 }
