@@ -17,7 +17,8 @@ inline void on_parsed(CLI::App* command, int& exit_code, std::function<int()> ac
 
 void register_run_command(CLI::App& app, int& exit_code);
 void register_log_commands(CLI::App& app, int& exit_code);   // record, replay
-void register_clip_commands(CLI::App& app, int& exit_code);  // clip info, clip fk
+void register_clip_commands(CLI::App& app, int& exit_code);  // clip info, clip fk, fill, fill-eval
+void register_clip_fill_commands(CLI::App* clip, int& exit_code);  // clip fill, clip fill-eval (from the above)
 void register_render_command(CLI::App& app, int& exit_code); // render (offline frames)
 void register_input_commands(CLI::App& app, int& exit_code);  // input list|monitor|decode, sim-pad
 void register_graph_commands(CLI::App& app, int& exit_code); // graph build, info, path

@@ -1,4 +1,4 @@
-// `marionette clip info`, `marionette clip fk` and `marionette clip retarget`.
+// `marionette clip info`, `marionette clip fk` and `marionette clip retarget` (fill and fill-eval: fill_commands.cpp).
 #include <fmt/format.h>
 
 #include <cstdio>
@@ -180,6 +180,7 @@ void register_clip_commands(CLI::App& app, int& exit_code) {
     rt->add_option("-o,--output", o->output_file, "the BVH file to write")->required();
     rt->add_flag("--json", o->json, "print the chains found and per-bone direction agreement as JSON");
     on_parsed(rt, exit_code, [o] { return clip_retarget_command(*o); });
+    register_clip_fill_commands(clip, exit_code);
 }
 
 }  // namespace marionette
