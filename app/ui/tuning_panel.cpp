@@ -101,7 +101,9 @@ void TuningUi::draw_row(std::size_t index) {
 void TuningUi::draw_panel(float width, float height) {
     const float margin = 8.0f;
     ImGui::SetNextWindowPos(ImVec2(margin, margin), ImGuiCond_Always);
-    ImGui::SetNextWindowSize(ImVec2(std::min(width - 2 * margin, 620.0f), height - 2 * margin), ImGuiCond_Always);
+    // The left part of the screen, so the puppet stays in view on the right.
+    const float panel = std::min(width - 2 * margin, std::max(400.0f, std::min(620.0f, width * 0.62f)));
+    ImGui::SetNextWindowSize(ImVec2(panel, height - 2 * margin), ImGuiCond_Always);
     ImGui::Begin("tuning  (back+start or F1: close)", nullptr,
                  ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoMove |
                      ImGuiWindowFlags_NoResize);
@@ -112,7 +114,7 @@ void TuningUi::draw_panel(float width, float height) {
     ImGui::TextColored(message_problem_ ? ImVec4(1.0f, 0.45f, 0.4f, 1.0f) : ImVec4(0.6f, 0.9f, 0.6f, 1.0f), "%s",
                        message_.empty() ? "A: adjust  B: back  d-pad: move  Y: save  LB/RB: fine/coarse" : message_.c_str());
     ImGui::Separator();
-    ImGui::PushItemWidth(std::max(120.0f, std::min(width - 2 * margin, 620.0f) - 300.0f));
+    ImGui::PushItemWidth(std::max(110.0f, panel * 0.42f));
     std::string table;
     bool open = false;
     for (std::size_t i = 0; i < keys_.size(); ++i) {

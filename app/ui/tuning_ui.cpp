@@ -67,7 +67,7 @@ TuningUi::TuningUi(render::Platform& platform, TuningUiOptions options)
     ImGuiIO& io = ImGui::GetIO();
     io.IniFilename = nullptr;  // no imgui.ini: the layout is fixed, nothing is written behind the user's back
     io.LogFilename = nullptr;
-    io.ConfigFlags |= ImGuiConfigFlags_NavEnableKeyboard | ImGuiConfigFlags_NavEnableGamepad;
+    io.ConfigFlags |= ImGuiConfigFlags_NavEnableGamepad;
     io.BackendFlags |= ImGuiBackendFlags_HasGamepad;
     ImGui::StyleColorsDark();
     ImGui::GetStyle().Colors[ImGuiCol_WindowBg].w = 0.88f;
@@ -75,6 +75,9 @@ TuningUi::TuningUi(render::Platform& platform, TuningUiOptions options)
         sdl_ = ImGui_ImplSDL2_InitForOpenGL(static_cast<SDL_Window*>(platform_.native_window()),
                                             platform_.native_context());
     }
+    // Keyboard navigation needs the SDL backend's key map (ImGui asserts without
+    // one): in a window only; on KMS and headless the pad alone navigates.
+    if (sdl_) io.ConfigFlags |= ImGuiConfigFlags_NavEnableKeyboard;
     renderer_ = std::make_unique<render::ImGuiGles3Renderer>();
 }
 
