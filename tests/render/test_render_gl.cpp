@@ -290,7 +290,7 @@ TEST_CASE("golden image: the tuning UI open over the puppet", "[render][golden][
     check_golden("tuning_ui_open_walk_stop_t600", snapshot(view));
 }
 
-TEST_CASE("the pad chord opens and closes the tuning UI; the d-pad and south move a slider", "[render][ui]") {
+TEST_CASE("the pad chord opens and closes the tuning UI, the d-pad and south move a slider", "[render][ui]") {
     const Replayed r = replay_ticks("stand_still", {10});
     render::View view(ui_platform(), render::RenderSettings{}, r.skeleton, r.terrain);
     ui::TuningUi tuning(view.platform(), ui::TuningUiOptions{default_config(), "", "", stderr});
@@ -337,7 +337,7 @@ TEST_CASE("the pad chord opens and closes the tuning UI; the d-pad and south mov
     CHECK_FALSE(tuning.is_open());
 }
 
-TEST_CASE("tuning UI edits pass the schema's checks; save keeps the file's comments and order", "[render][ui]") {
+TEST_CASE("tuning UI edits pass the schema's checks, save keeps the file's comments and order", "[render][ui]") {
     const Replayed r = replay_ticks("stand_still", {10});
     render::View view(ui_platform(), render::RenderSettings{}, r.skeleton, r.terrain);
     const std::string path = "ui_save_test.toml";
