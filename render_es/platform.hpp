@@ -109,6 +109,16 @@ struct PlatformEvents {
 
 enum class PresentResult { ok, failed, context_lost };
 
+// Something drawn over the scene that takes the window's events first (the
+// tuning UI, app/ui/). poll_events() hands it each native event (an SDL_Event
+// in a window; KMS and headless have none) before acting on it itself.
+class NativeEventHook {
+public:
+    virtual ~NativeEventHook() = default;
+    // True: the hook consumed the event and the platform ignores it.
+    virtual bool on_native_event(const void* event) = 0;
+};
+
 class Platform {
 public:
     virtual ~Platform() = default;
@@ -137,6 +147,14 @@ public:
     virtual void read_pixels(std::vector<std::uint8_t>& rgba) = 0;
     // Human-readable "EGL 1.5, OpenGL ES 3.2 Mesa ..., llvmpipe ..."
     virtual std::string description() const = 0;
+    // The window's SDL_Window* and SDL_GLContext (nullptr on KMS and headless).
+    virtual void* native_window() const { return nullptr; }
+    virtual void* native_context() const { return nullptr; }
+    // poll_events() offers each event to `hook` first (null: none).
+    void set_native_event_hook(NativeEventHook* hook) { hook_ = hook; }
+
+protected:
+    NativeEventHook* hook_ = nullptr;
 };
 
 // recover()'s shape on every platform: tear the context down, then build it

@@ -74,6 +74,7 @@ public:
         SDL_Event event;
         while (SDL_PollEvent(&event)) {
             if (event.type == SDL_QUIT) e.close_requested = true;
+            if (hook_ != nullptr && hook_->on_native_event(&event)) continue;
             if (event.type == SDL_WINDOWEVENT && event.window.event == SDL_WINDOWEVENT_SIZE_CHANGED) e.resized = true;
             if (event.type == SDL_KEYDOWN && event.key.repeat == 0) {
                 switch (event.key.keysym.sym) {
@@ -107,6 +108,8 @@ public:
         read_rgba_top_down(resolved_.framebuffer, width_, height_, rgba);
     }
 
+    void* native_window() const override { return window_; }
+    void* native_context() const override { return context_; }
     std::string description() const override {
         return std::string("window (SDL ") + SDL_GetCurrentVideoDriver() + ", vsync " + (vsync_ ? "on" : "off") + "), " + gl_;
     }

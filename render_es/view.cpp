@@ -24,6 +24,7 @@ FrameResult View::frame(const PuppetState& state, const DebugOverlay& overlay, s
 
     platform_->begin_frame();
     renderer_->draw(state, overlay, hud_text, platform_->width(), platform_->height(), dt_s);
+    if (layer_ != nullptr) layer_->draw(platform_->width(), platform_->height(), dt_s);
     result.present = platform_->present();
     result.present_ns = result.present == PresentResult::ok ? platform_->last_present_ns() : 0;
     if (result.present != PresentResult::ok) {
@@ -33,6 +34,7 @@ FrameResult View::frame(const PuppetState& state, const DebugOverlay& overlay, s
                                 " platform: the context was lost and could not be recreated");
         platform_->begin_frame();
         renderer_->recreate();
+        if (layer_ != nullptr) layer_->recreate();
         result.recovered = true;
         ++recoveries_;
     }

@@ -15,6 +15,15 @@
 
 namespace marionette::render {
 
+// Drawn over the scene, after the HUD and before present (the tuning UI).
+class ViewLayer {
+public:
+    virtual ~ViewLayer() = default;
+    virtual void draw(std::int32_t width, std::int32_t height, float dt_s) = 0;
+    // The context was recreated: rebuild every GL name.
+    virtual void recreate() = 0;
+};
+
 struct FrameResult {
     PresentResult present = PresentResult::ok;
     // When the frame reached the screen (CLOCK_MONOTONIC ns) if the platform knows:
@@ -36,6 +45,8 @@ public:
     // The last presented frame as a PNG. Throws std::runtime_error.
     void screenshot(const std::string& path);
 
+    // Draws `layer` over every frame from now on (null: none); not owned.
+    void set_layer(ViewLayer* layer) { layer_ = layer; }
     Platform& platform() { return *platform_; }
     Renderer& renderer() { return *renderer_; }
     std::uint64_t recoveries() const { return recoveries_; }
@@ -44,6 +55,7 @@ private:
     std::unique_ptr<Platform> platform_;
     std::unique_ptr<Renderer> renderer_;
     std::uint64_t recoveries_ = 0;
+    ViewLayer* layer_ = nullptr;
     std::vector<std::uint8_t> pixels_;
 };
 

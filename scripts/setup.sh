@@ -14,6 +14,8 @@ packages=(
   libevdev-dev libhidapi-dev libsdl2-dev umockdev libumockdev-dev evemu-tools
   # render_es: EGL + GLES 3, KMS/GBM, seat access, PNG output; Mesa's llvmpipe for headless runs
   libegl-dev libgles-dev libgbm-dev libdrm-dev libseat-dev libstb-dev libegl-mesa0 libgl1-mesa-dri xvfb xauth
+  # the in-app tuning UI (app/ui/, docs/ui.md): Dear ImGui 1.86, static library and headers
+  libimgui-dev
   # motion graph: BLAS for the distance matrix
   libopenblas-dev
   # structure check (scripts/check_structure.py): function extents

@@ -350,6 +350,9 @@ int run_command(const RunOptions& o) {
     p.test_stall_simulation_ms = test_stall_from_environment();
     p.trace_file = o.trace_file;
     p.watch_config_file = o.config_file;  // live tuning of the file given
+    p.ui = config.ui.enabled;              // the tuning UI over a window or KMS (docs/ui.md)
+    p.ui_base = config;
+    p.ui_config_file = config_found.file;
     p.stop_request = &g_stop_requested;
     p.stop_request_time_ns = &g_stop_requested_ns;
 

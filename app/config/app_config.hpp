@@ -66,12 +66,20 @@ struct TimingConfig {
     bool operator==(const TimingConfig&) const = default;
 };
 
+// [ui]: the in-app tuning UI (app/ui/, docs/ui.md), read at start only, never
+// in logs. enabled = false locks it (a kiosk in service mode).
+struct UiConfig {
+    bool enabled = true;
+    bool operator==(const UiConfig&) const = default;
+};
+
 struct AppConfig {
     SimConfig sim;                 // what the tick reads; logs embed exactly this
     RealtimeConfig realtime;
     GraphBuildConfig graph_build;
     RecordingConfig recording;
     TimingConfig timing;
+    UiConfig ui;
 };
 
 }  // namespace marionette

@@ -38,10 +38,14 @@ SimConfig& part_of(AppConfig& c, const SimConfig*) { return c.sim; }
 RealtimeConfig& part_of(AppConfig& c, const RealtimeConfig*) { return c.realtime; }
 GraphBuildConfig& part_of(AppConfig& c, const GraphBuildConfig*) { return c.graph_build; }
 RecordingConfig& part_of(AppConfig& c, const RecordingConfig*) { return c.recording; }
+const SimConfig& part_of(const AppConfig& c, const SimConfig*) { return c.sim; }
+const RealtimeConfig& part_of(const AppConfig& c, const RealtimeConfig*) { return c.realtime; }
+const GraphBuildConfig& part_of(const AppConfig& c, const GraphBuildConfig*) { return c.graph_build; }
+const RecordingConfig& part_of(const AppConfig& c, const RecordingConfig*) { return c.recording; }
 
 // Calls visit(value) with a reference to the field's value in `config`.
-template <typename Visit>
-void visit_field(AppConfig& config, const Field& field, Visit&& visit) {
+template <typename Config, typename Visit>
+void visit_field(Config& config, const Field& field, Visit&& visit) {
     std::visit(
         [&](auto member) {
             using Part = typename MemberOf<decltype(member)>::part;
@@ -165,6 +169,16 @@ constexpr const char* kInterpolationDoc =
 void apply_motion_source(SimConfig& config, const toml::node& node, const std::string& file);
 void apply_interpolation(TimingConfig& timing, const toml::node& node, const std::string& file);
 
+bool is_sim_field(const Field& field) {
+    return std::visit([](auto member) { return std::is_same_v<typename MemberOf<decltype(member)>::part, SimConfig>; }, field);
+}
+
+const KeySpec* find_key(std::string_view table, std::string_view key) {
+    for (const KeySpec& k : kKeys)
+        if (table == k.table && key == k.key) return &k;
+    return nullptr;
+}
+
 int line_of(const toml::node& node) { return static_cast<int>(node.source().begin.line); }
 
 std::string known_keys_of(std::string_view table) {
@@ -173,6 +187,7 @@ std::string known_keys_of(std::string_view table) {
         if (table == k.table) out += (out.empty() ? "" : ", ") + std::string(k.key);
     if (table == "motion_graph") out += ", buttons (the [motion_graph.buttons] table)";
     if (table == "timing") out = "interpolation";
+    if (table == "ui") out = "enabled";
     return out;
 }
 
@@ -184,7 +199,7 @@ std::string known_tables() {
             out += (out.empty() ? "" : ", ") + std::string(k.table);
             last = k.table;
         }
-    return out + ", terrain, timing";
+    return out + ", terrain, timing, ui";
 }
 
 template <typename Number>
@@ -372,8 +387,11 @@ std::string serialize_buttons(const SimConfig& config) {
 std::vector<ConfigKeyInfo> config_schema() {
     std::vector<ConfigKeyInfo> out;
     for (const KeySpec& k : kKeys)
-        out.push_back({k.table, k.key, is_integer(k.field) ? "integer" : "float", k.min, k.max, k.doc});
-    out.push_back({"motion", "source", "string", 0, 0, "what poses the puppet: auto, gait, graph, graph_feet or matching"});
+        out.push_back({k.table, k.key, is_integer(k.field) ? "integer" : "float", k.min, k.max, k.doc,
+                       is_sim_field(k.field) && std::string_view(k.table) != "puppet" &&
+                           std::string_view(k.key) != "tick_rate_hz"});
+    out.push_back({"motion", "source", "string", 0, 0, "what poses the puppet: auto, gait, graph, graph_feet or matching", true});
+    out.push_back({"ui", "enabled", "boolean", 0, 0, "false locks the in-app tuning UI (a kiosk in service mode)"});
     out.push_back({"timing", "interpolation", "string", 0, 0, kInterpolationDoc});
     for (const std::string_view b : kButtonNames)
         out.push_back({"motion_graph.buttons", std::string(b), "string", 0.0, 0.0, "graph label played when the button is pressed, \"\" for none"});
@@ -406,6 +424,12 @@ AppConfig apply_config_text(const AppConfig& base, std::string_view text, const 
             const std::string full = table_name + "." + std::string(key.str());
             if (table_name == "motion" && key.str() == "source") {
                 apply_motion_source(config, node, file);
+                continue;
+            }
+            if (table_name == "ui" && key.str() == "enabled") {
+                const auto* b = node.as_boolean();
+                if (!b) throw ConfigError(file, line_of(node), full, "expected true or false");
+                app.ui.enabled = b->get();
                 continue;
             }
             if (table_name == "timing" && key.str() == "interpolation") {
@@ -470,6 +494,25 @@ void apply_interpolation(TimingConfig& timing, const toml::node& node, const std
                           " (expected \"interpolate\", \"extrapolate\" or \"latest\")");
 }
 }  // namespace
+
+std::optional<std::string> config_value_text(const AppConfig& config, std::string_view table, std::string_view key) {
+    const KeySpec* spec = find_key(table, key);
+    if (!spec) return std::nullopt;
+    std::string out;
+    visit_field(config, spec->field, [&](const auto& value) {
+        if constexpr (std::is_same_v<std::remove_cvref_t<decltype(value)>, std::int32_t>) out = std::to_string(value);
+        else out = format_number(value);
+    });
+    return out;
+}
+
+std::optional<double> config_number(const AppConfig& config, std::string_view table, std::string_view key) {
+    const KeySpec* spec = find_key(table, key);
+    if (!spec) return std::nullopt;
+    double out = 0.0;
+    visit_field(config, spec->field, [&](const auto& value) { out = static_cast<double>(value); });
+    return out;
+}
 
 std::string interpolation_name(Interpolation mode) { return kInterpolationNames[static_cast<std::size_t>(mode)]; }
 

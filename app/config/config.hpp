@@ -3,6 +3,7 @@
 // (config/marionette.toml, also compiled into the binary) states every key; a user
 // file overrides only what it names. Errors name file, line, key and what was
 // expected.
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -32,11 +33,20 @@ struct ConfigKeyInfo {
     double min = 0.0;
     double max = 0.0;
     std::string doc;
+    // A live edit reaches the tick: a SimConfig key that is not structural
+    // (simulation.tick_rate_hz, [puppet]). False for keys read at start or by graph builds.
+    bool live = false;
 };
 
 // Every key the configuration accepts, in the order the effective text lists them.
 std::vector<ConfigKeyInfo> config_schema();
 
+// A numeric key's value in `config` as the effective text writes it (floats in
+// the shortest text that reads back to the same bits); nothing for an unknown
+// or non-numeric key.
+std::optional<std::string> config_value_text(const AppConfig& config, std::string_view table, std::string_view key);
+// The same value as a number.
+std::optional<double> config_number(const AppConfig& config, std::string_view table, std::string_view key);
 // "auto", "gait", "graph", "graph_feet" or "matching", as [motion] source spells it.
 std::string motion_source_name(MotionSourceSetting source);
 // [timing] interpolation: "interpolate", "extrapolate" or "latest".

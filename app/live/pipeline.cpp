@@ -19,6 +19,7 @@
 #include "app/graph/graph_files.hpp"
 #include "app/live/realtime.hpp"
 #include "app/live/service_notify.hpp"
+#include "app/ui/tuning_ui.hpp"
 #include "app/eval/replay.hpp"
 #include "input/input_thread.hpp"
 #include "render_es/interpolate.hpp"
@@ -76,7 +77,12 @@ void SimulationLoop::run_tick(std::int64_t tick_time_ns, std::int64_t now_ns) {
     // The oldest sample due has waited longest: it is this tick's worst latency.
     if (const TimedInput* oldest = shared_.input_ring.peek(); oldest && oldest->timestamp_ns <= tick_time_ns)
         if (now_ns - oldest->timestamp_ns > latency_window_max_ns_) latency_window_max_ns_ = now_ns - oldest->timestamp_ns;
-    const TickInput input = assembler_.assemble(shared_.input_ring, tick_time_ns, now_ns, latency_);
+    const TickInput pad = assembler_.assemble(shared_.input_ring, tick_time_ns, now_ns, latency_);
+    if (const std::uint32_t event = ui::press_event(previous_buttons_, pad.buttons); event != 0)
+        (void)shared_.pad_events.try_push(event);  // full: nobody is reading (no display), drop it
+    previous_buttons_ = pad.buttons;
+    // The tuning UI is open: the pad drives it, the puppet gets (and the log records) rest.
+    const TickInput input = shared_.ui_captures_input.load(std::memory_order_relaxed) ? TickInput{} : pad;
     if ((k + 1) % static_cast<std::uint64_t>(sim_.config().tick_rate_hz) == 0) {
         shared_.counters.input_latency_max_ns.store(latency_window_max_ns_, std::memory_order_relaxed);
         latency_window_max_ns_ = 0;
@@ -93,6 +99,7 @@ void SimulationLoop::run_tick(std::int64_t tick_time_ns, std::int64_t now_ns) {
     input_stamps_[now.tick % kTickStampHistory] = {now.tick, assembler_.last_samples(), assembler_.last_oldest_ns(),
                                                    assembler_.last_newest_ns(), now_ns};
     frame.recent_inputs = input_stamps_;
+    frame.pad = pad;
     shared_.states.publish();
 
     record_.kind = TickRecord::Kind::tick;
@@ -352,7 +359,42 @@ struct RenderInputs {
     Interpolation interpolation = Interpolation::interpolate;
     std::uint64_t stall_after_frames = 0;  // test hook: PipelineOptions::test_render_stall_ns
     std::int64_t stall_ns = 0;
+    const ui::TuningUiOptions* ui = nullptr;  // the tuning UI over the display (null: none)
 };
+
+// The tuning UI, made on the render thread once the view is open (its GL
+// context is current here); null without a display or with [ui] enabled = false.
+std::unique_ptr<ui::TuningUi> open_tuning_ui(render::View* view, const RenderInputs& in) {
+    if (view == nullptr || in.ui == nullptr) return nullptr;
+    auto tuning = std::make_unique<ui::TuningUi>(view->platform(), *in.ui);
+    view->set_layer(tuning.get());
+    view->platform().set_native_event_hook(tuning.get());
+    return tuning;
+}
+
+// Before a frame: what the writer accepted, the pad, and whether the puppet gets it.
+void feed_tuning_ui(ui::TuningUi* tuning, PipelineShared& sh, const StateFrame& pair) {
+    if (tuning == nullptr) return;
+    if (sh.accepted_configs.take()) tuning->adopt(sh.accepted_configs.front());
+    // One press a frame, in order: ImGui sees each go down in one frame and up
+    // in the next, so a d-pad move and the south press after it stay in order
+    // however slow the frames are.
+    // While closed only the chord matters: the queue is drained up to it.
+    std::uint32_t event = 0;
+    if (!tuning->is_open()) {
+        for (std::uint32_t e = 0; event == 0 && sh.pad_events.try_pop(e);)
+            if (e & ui::kChordMade) event = e;
+    } else if (!tuning->releasing()) {
+        (void)sh.pad_events.try_pop(event);
+    }
+    tuning->feed_pad(pair.pad, event, sh.pad_events.peek() == nullptr);
+    sh.ui_captures_input.store(tuning->is_open(), std::memory_order_relaxed);
+}
+
+// After a frame: an edit made in it goes to the writer.
+void hand_over_ui_edit(ui::TuningUi* tuning, PipelineShared& sh) {
+    if (tuning != nullptr && tuning->take_edit(sh.ui_edits.back().config)) sh.ui_edits.publish();
+}
 
 // Each frame is stamped when presented: the page flip's vblank time on KMS, after
 // the swap in a window, the frame loop's end headless (the frame's own time in
@@ -373,6 +415,12 @@ void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, Ren
         }
     } else {
         display.state.store(DisplayThreadState::ready, std::memory_order_release);
+    }
+    std::unique_ptr<ui::TuningUi> tuning;
+    try {
+        tuning = open_tuning_ui(view.get(), in);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "warning: the tuning UI is off: %s\n", e.what());
     }
     // Everything a GL frame needs, made once.
     PuppetState drawn{};
@@ -412,8 +460,10 @@ void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, Ren
                 c.tick_time_max_ns.load(std::memory_order_relaxed) / 1e3,
                 c.input_latency_max_ns.load(std::memory_order_relaxed) / 1e6,
                 c.samples_dropped.load(std::memory_order_relaxed), c.missed_frames.load(std::memory_order_relaxed));
+            feed_tuning_ui(tuning.get(), sh, pair);
             const render::FrameResult r = view->frame(drawn, overlay, std::string_view(hud.data(), n.size),
                                                       static_cast<float>(period) / 1e9f);
+            hand_over_ui_edit(tuning.get(), sh);
             if (r.events.close_requested) {
                 display.closed.store(true, std::memory_order_release);
                 break;
@@ -500,6 +550,7 @@ struct LiveTuning {
     SimConfig published;       // the newest configuration handed over
     RealtimeConfig realtime;   // the thread settings the run started with (fixed)
     TimingConfig timing;       // what the render thread draws (fixed)
+    UiConfig ui;               // the tuning UI's lock (fixed)
     // Only its fixed-after-start part is read (motion_source_allowed), so this
     // thread may ask it while the simulation thread steps.
     const Simulation* simulation = nullptr;
@@ -512,6 +563,7 @@ struct LiveTuning {
     // Waits up to `wait_ms` for an edit of the watched file (without one,
     // just waits) and hands the file over once it has been quiet for kEditQuietNs.
     void wait_and_poll(PipelineShared& sh, std::FILE* err, int wait_ms) {
+        if (sh.ui_edits.take()) offer(sh, sh.ui_edits.front().config, "tuning UI", err);
         if (!watcher) {
             poll(nullptr, 0, wait_ms);  // a signal ends it early (EINTR)
             return;
@@ -539,13 +591,20 @@ struct LiveTuning {
             log_message(LogLevel::warning, fmt::format("config: {}: {}; keeping the previous configuration", watcher->path(), e.what()), err);
             return;
         }
+        offer(sh, next, watcher->path(), err);
+    }
+
+    // A whole configuration from the watched file or the tuning UI: refused when
+    // it changes what cannot change while running, else handed to the simulation.
+    void offer(PipelineShared& sh, const AppConfig& next, const std::string& origin, std::FILE* err) {
         Outcome kept = structure_unchanged(published, next.sim);
         if (kept.ok() && !(next.realtime == realtime)) kept = Outcome::failure("realtime (thread settings)");
         if (kept.ok() && !(next.timing == timing)) kept = Outcome::failure("timing.interpolation");
+        if (kept.ok() && !(next.ui == ui)) kept = Outcome::failure("ui.enabled");
         if (kept.ok() && simulation) kept = simulation->motion_source_allowed(next.sim);
         if (!kept.ok()) {
             log_message(LogLevel::warning, fmt::format("config: {}: {} cannot change while running (restart to apply it); keeping the previous configuration",
-                       watcher->path(), kept.problem()), err);
+                       origin, kept.problem()), err);
             return;
         }
         // The graph build keys are not the tick's: an edit of only those changes nothing here.
@@ -556,6 +615,8 @@ struct LiveTuning {
         update.version = ++version;
         update.config = next.sim;
         sh.config_updates.publish();
+        sh.accepted_configs.back() = next.sim;
+        sh.accepted_configs.publish();
     }
 };
 
@@ -794,6 +855,7 @@ private:
         LiveTuning tuning;
         tuning.published = o.config;
         tuning.realtime = o.realtime;
+        tuning.ui = o.ui_base.ui;
         tuning.timing.interpolation = o.interpolation;
         tuning.simulation = &sim;
         if (!o.watch_config_file.empty()) tuning.watcher = std::make_unique<ConfigWatcher>(o.watch_config_file);
@@ -827,7 +889,8 @@ private:
         const RenderInputs inputs{&o_.display,       &sim.skeleton(),
                                   &sim.terrain(),    o_.config.ankle_height,
                                   o_.config.tick_rate_hz, o_.interpolation,
-                                  o_.test_render_stall_after_frames, o_.test_render_stall_ns};
+                                  o_.test_render_stall_after_frames, o_.test_render_stall_ns,
+                                  o_.ui ? &ui_options_ : nullptr};
         gfx_thread_ = std::thread(render_thread, std::ref(sh_), o_.frame_rate_hz, o_.virtual_time, inputs,
                                   std::ref(display_), std::ref(result_.frame_time), std::ref(result_.present_latency));
         while (display_.state.load(std::memory_order_acquire) == DisplayThreadState::opening)
@@ -906,6 +969,7 @@ private:
     LiveTuning tuning_;
     SimulationThreadResult sim_result_;
     DisplayThreadState display_;
+    ui::TuningUiOptions ui_options_{o_.ui_base, o_.ui_config_file, "", o_.out};
     std::thread sim_thread_, in_thread_, gfx_thread_;
     std::unique_ptr<input::InputThread> device_ = std::make_unique<input::InputThread>();  // stopped (joined) by its destructor
     ThreadGuard guard_{{&sim_thread_, &in_thread_, &gfx_thread_}, sh_};

@@ -19,6 +19,7 @@
 
 #include "app/config/app_config.hpp"
 #include "app/live/recording.hpp"
+#include "app/ui/pad_presses.hpp"
 #include "render_es/platform.hpp"
 #include "render_es/settings.hpp"
 #include "runtime/formats/input_log.hpp"
@@ -61,6 +62,9 @@ struct StateFrame {
     std::int64_t tick_ns = 0;
     bool connected = true;             // the controller, for the on-screen notice
     TickStampHistory recent_inputs{};  // the input that reached `current` and the ticks before it
+    // The tuning UI's pad (docs/ui.md): the newest tick's input as the pad gave
+    // it (before the UI, when open, took it from the puppet).
+    TickInput pad{};
 };
 
 // Simulation → writer, per tick (and per configuration change, in order).
@@ -88,6 +92,12 @@ using RecordRing = SpscRing<TickRecord, kRecordRingCapacity>;
 struct ConfigUpdate {
     std::uint32_t version = 0;
     SimConfig config{};
+};
+
+// A configuration the tuning UI made (render thread → writer), offered to the
+// simulation as a live edit of the file would be.
+struct UiEdit {
+    AppConfig config;
 };
 
 // A change recorded in an input log, applied before tick `before_tick` (0-based).
@@ -119,6 +129,14 @@ struct PipelineShared {
     RecordRing records;
     LatestValue<StateFrame> states;
     LatestValue<ConfigUpdate> config_updates;
+    // The tuning UI (docs/ui.md). While it is open the simulation gets the pad
+    // at rest (the recorded input is that rest, so replay needs no UI); its
+    // edits go to the writer, and every configuration the writer hands over
+    // comes back to it, so a file edit and a panel edit never undo each other.
+    std::atomic<bool> ui_captures_input{false};
+    ui::PadEventRing pad_events;       // presses, in order (ui::press_event)
+    LatestValue<UiEdit> ui_edits;
+    LatestValue<SimConfig> accepted_configs;
     // Virtual time only: the newest timestamp the input thread has pushed.
     std::atomic<std::int64_t> input_watermark_ns{INT64_MIN};
     std::atomic<bool> input_done{false};
@@ -159,6 +177,7 @@ private:
     std::int64_t latency_window_max_ns_ = 0;
     std::uint64_t config_changes_ = 0;
     TickStampHistory input_stamps_{};  // copied into every published state pair
+    std::uint32_t previous_buttons_ = 0;
     TickRecord record_{};  // reused, so the tick builds no large temporaries
 };
 
@@ -270,6 +289,10 @@ struct PipelineOptions {
     int frame_rate_hz = 60;            // the headless frame loop's pace
     Interpolation interpolation = Interpolation::interpolate;  // [timing]: what the render thread draws
     DisplayOptions display;
+    // The tuning UI over the display (docs/ui.md): off when [ui] enabled = false.
+    bool ui = false;
+    AppConfig ui_base;                 // the run's whole configuration
+    std::string ui_config_file;        // the file it came from ("" = defaults): Save writes there
     std::string record_file;           // input log ("" = none): its first file (app/live/recording.hpp)
     std::string record_rotate_dir;     // --record auto: keep the [recording] limits by deleting the oldest here
     RecordingLimits record_limits;

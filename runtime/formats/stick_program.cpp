@@ -159,9 +159,17 @@ StickProgram parse_stick_program(std::string_view text, const std::string& file)
         } else if (verb == "press") {
             seg.kind = StickSegment::Kind::press;
             if (words.size() < 2 || words.size() > 3) p.fail("expected 'press BUTTON [DURATION]'");
-            const auto button = button_from_name(words[1]);
-            if (!button) p.fail("unknown button '" + std::string(words[1]) + "'");
-            seg.buttons = button_bit(*button);
+            // BUTTON or a chord BUTTON+BUTTON+... (held together, e.g. back+start).
+            std::string_view names = words[1];
+            while (true) {
+                const std::size_t plus = names.find('+');
+                const std::string_view name = names.substr(0, plus);
+                const auto button = button_from_name(name);
+                if (!button) p.fail("unknown button '" + std::string(name) + "'");
+                seg.buttons |= button_bit(*button);
+                if (plus == std::string_view::npos) break;
+                names.remove_prefix(plus + 1);
+            }
             seg.duration_s = words.size() == 3 ? p.duration(words[2]) : 0.1;
         } else {
             p.fail("unknown command '" + std::string(verb) + "' (expected hold, ramp, circle or press)");

@@ -10,11 +10,14 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "app/config/config.hpp"
 #include "app/config/program_source.hpp"
 #include "app/config/render_config.hpp"
 #include "app/eval/replay.hpp"
+#include "app/ui/tuning_ui.hpp"
 #include "render_es/gl_util.hpp"
 #include "render_es/image.hpp"
 #include "render_es/view.hpp"
@@ -251,4 +254,137 @@ TEST_CASE("the SDL window platform draws the golden frame under Xvfb", "[.window
     CHECK(result.present == render::PresentResult::ok);
     CHECK_FALSE(result.events.close_requested);
     check_golden("walk_stop_t600", snapshot(view));
+}
+
+// ---- the tuning UI (app/ui/, docs/ui.md) -------------------------------------
+
+namespace {
+render::PlatformOptions ui_platform() {
+    render::PlatformOptions p = golden_platform();
+    p.width = 640;  // the panel needs more room than the puppet goldens
+    p.height = 400;
+    return p;
+}
+
+std::string file_text(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+}  // namespace
+
+TEST_CASE("golden image: the tuning UI open over the puppet", "[render][golden][ui]") {
+    const Replayed r = replay_ticks("walk_stop", {600});
+    render::RenderSettings settings;
+    render::View view(ui_platform(), settings, r.skeleton, r.terrain);
+    ui::TuningUiOptions options{default_config(), "", "", stderr};
+    ui::TuningUi tuning(view.platform(), options);
+    view.set_layer(&tuning);
+    tuning.feed_pad(TickInput{}, 0, true);
+    tuning.set_open(true);
+    render::DebugOverlay overlay{};
+    render::feet_overlay_from_state(r.states[0], r.terrain, r.ankle_height, overlay);
+    // ImGui lays a new window out over its first frames; the third is settled.
+    for (int i = 0; i < 3; ++i) view.frame(r.states[0], overlay, "", 1.0f / 60.0f);
+    check_golden("tuning_ui_open_walk_stop_t600", snapshot(view));
+}
+
+TEST_CASE("the pad chord opens and closes the tuning UI, the d-pad and south move a slider", "[render][ui]") {
+    const Replayed r = replay_ticks("stand_still", {10});
+    render::View view(ui_platform(), render::RenderSettings{}, r.skeleton, r.terrain);
+    ui::TuningUi tuning(view.platform(), ui::TuningUiOptions{default_config(), "", "", stderr});
+    view.set_layer(&tuning);
+    std::uint32_t held = 0;
+    // One frame per tick of pad input, as the render thread would see them.
+    auto frame_with = [&](std::uint32_t buttons) {
+        const std::uint32_t event = ui::press_event(held, buttons);
+        held = buttons;
+        TickInput pad;
+        pad.buttons = buttons;
+        tuning.feed_pad(pad, event, true);
+        view.frame(r.states[0], render::DebugOverlay{}, "", 1.0f / 60.0f);
+    };
+    auto press = [&](Button b) {
+        frame_with(button_bit(b));
+        frame_with(0);
+    };
+    frame_with(0);
+    CHECK_FALSE(tuning.is_open());
+    frame_with(button_bit(Button::back));  // back alone is not the chord
+    frame_with(0);
+    CHECK_FALSE(tuning.is_open());
+    frame_with(ui::kUiChord);
+    CHECK(tuning.is_open());
+    frame_with(0);
+    frame_with(0);
+    // The first slider (gait.pelvis_height) has the focus; down to step_length_multiplier, A, right ×2, A.
+    const float before = tuning.working().sim.step_length_multiplier;
+    press(Button::dpad_down);
+    press(Button::south);
+    press(Button::dpad_right);
+    press(Button::dpad_right);
+    press(Button::south);
+    const float after = tuning.working().sim.step_length_multiplier;
+    INFO("message: " << tuning.message());
+    CHECK(after > before);
+    CHECK(after == Approx(before + 2 * 0.0195f).margin(0.002f));
+    AppConfig handed{};
+    CHECK(tuning.take_edit(handed));
+    CHECK(handed.sim.step_length_multiplier == after);
+    CHECK_FALSE(tuning.take_edit(handed));  // once per edit
+    frame_with(ui::kUiChord);
+    CHECK_FALSE(tuning.is_open());
+}
+
+TEST_CASE("tuning UI edits pass the schema's checks, save keeps the file's comments and order", "[render][ui]") {
+    const Replayed r = replay_ticks("stand_still", {10});
+    render::View view(ui_platform(), render::RenderSettings{}, r.skeleton, r.terrain);
+    const std::string path = "ui_save_test.toml";
+    const std::string original = "# my walk\n[gait]   # tuned by hand\nwalk_duty = 0.6   # planted longer\n\n[locomotion]\nmax_speed = 3.0\n";
+    std::ofstream(path) << original;
+    ui::TuningUi tuning(view.platform(), ui::TuningUiOptions{load_config(path), path, "", stderr});
+
+    CHECK(tuning.edit("gait", "step_length_multiplier", "0.62"));
+    CHECK(tuning.edit("gait", "walk_duty", "0.7"));
+    CHECK(tuning.edit("locomotion", "stick_deadzone", "0.2"));
+    // Out of range, and a relation between keys: refused, the working copy unchanged, the message names the key.
+    CHECK_FALSE(tuning.edit("gait", "walk_duty", "0.95"));
+    CHECK_THAT(tuning.message(), Catch::Contains("gait.walk_duty") && Catch::Contains("[0.5, 0.9]"));
+    CHECK_FALSE(tuning.edit("gait", "min_step_duration", "2.0"));
+    CHECK(tuning.working().sim.walk_duty == 0.7f);
+    // Every documented key of the panel's tables, with the schema's range; graph build keys locked.
+    for (const ConfigKeyInfo& k : config_schema()) {
+        if (k.table != "gait" && k.table != "motion" && k.table != "motion_graph") continue;
+        bool found = false;
+        for (const ui::PanelKey& p : ui::panel_keys())
+            if (p.table == k.table && p.key == k.key) {
+                found = true;
+                CHECK(p.min == k.min);
+                CHECK(p.max == k.max);
+                CHECK(p.locked == (!k.live || k.type == "string"));
+            }
+        INFO(k.table << "." << k.key);
+        CHECK(found);
+    }
+    REQUIRE(tuning.save(path));
+    const std::string saved = file_text(path);
+    CHECK(saved == "# my walk\n[gait]   # tuned by hand\nwalk_duty = 0.7   # planted longer\nstep_length_multiplier = 0.62\n\n"
+                   "[locomotion]\nmax_speed = 3.0\nstick_deadzone = 0.2\n");
+    const AppConfig reloaded = load_config(path);
+    CHECK(reloaded.sim.step_length_multiplier == 0.62f);
+    CHECK(reloaded.sim.walk_duty == 0.7f);
+    CHECK(reloaded.sim.stick_deadzone == 0.2f);
+    // Reset to the default and save again: the default value is written.
+    for (const ui::PanelKey& p : ui::panel_keys())
+        if (p.key == "walk_duty") CHECK(tuning.reset(p));
+    REQUIRE(tuning.save(path));
+    CHECK(load_config(path).sim.walk_duty == default_config().sim.walk_duty);
+    CHECK(file_text(path).find("# planted longer") != std::string::npos);
+    // A new file holds just the edited keys.
+    std::filesystem::remove("ui_new.toml");
+    REQUIRE(tuning.save("ui_new.toml"));
+    CHECK(load_config("ui_new.toml").sim.step_length_multiplier == 0.62f);
+    std::filesystem::remove(path);
+    std::filesystem::remove("ui_new.toml");
 }

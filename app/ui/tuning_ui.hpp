@@ -1,0 +1,126 @@
+#pragma once
+// The in-app tuning UI (docs/ui.md): a Dear ImGui panel drawn over the puppet
+// by the render thread only, opened by the pad chord back + start or F1, and
+// navigable with the pad (ImGui gamepad navigation fed from the simulation's
+// newest input, so it works on KMS where there is no SDL), the keyboard and the
+// mouse (the SDL window, through the packaged SDL2 backend).
+//
+// It never touches the simulation. An edit is applied to a working copy of the
+// configuration with the same schema and checks as a file (apply_config_text);
+// the copy is then handed to the writer thread, which offers it to the
+// simulation exactly as the file watcher offers a live edit: applied at a tick
+// boundary, written into the input log as a configuration change, so `replay`
+// reproduces the session. Save writes the edited keys back into the TOML file
+// they came from (toml_edit.hpp keeps its comments and key order), or a new one.
+#include <array>
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "app/config/app_config.hpp"
+#include "app/ui/pad_presses.hpp"
+#include "render_es/platform.hpp"
+#include "render_es/view.hpp"
+#include "runtime/sim/tick_input.hpp"
+
+struct ImGuiContext;
+
+namespace marionette::render {
+class ImGuiGles3Renderer;
+}
+
+namespace marionette::ui {
+
+struct TuningUiOptions {
+    AppConfig base;           // the run's configuration: defaults, then source_file
+    std::string source_file;  // where it came from ("" = the defaults only)
+    std::string save_file;    // where Save writes ("" = source_file, else marionette-tuned.toml)
+    std::FILE* out = stderr;  // one line per edit, save and refusal
+};
+
+// One row of the parameter panel: a documented key with its range.
+struct PanelKey {
+    std::string table;
+    std::string key;
+    std::string type;        // "integer", "float" or "string"
+    double min = 0.0;
+    double max = 0.0;
+    std::string doc;
+    bool locked = false;     // shown, not editable: read at start or by graph builds only
+    std::string why_locked;
+};
+// The panel's keys: every documented key of [gait], [motion], [motion_graph]
+// and the stick dead zone ([locomotion] stick_deadzone), in that order of
+// tables and in schema order within each.
+std::vector<PanelKey> panel_keys();
+
+class TuningUi final : public render::ViewLayer, public render::NativeEventHook {
+public:
+    // On the render thread, with the platform's context current.
+    TuningUi(render::Platform& platform, TuningUiOptions options);
+    ~TuningUi() override;
+    TuningUi(const TuningUi&) = delete;
+    TuningUi& operator=(const TuningUi&) = delete;
+
+    // Before each frame: the newest tick's buttons and sticks (as the pad held
+    // them, before the UI took them from the puppet), one press event
+    // (ui::press_event; 0: none) and whether the press queue is now empty: the
+    // held buttons count only then, so a queued press is never overtaken.
+    void feed_pad(const TickInput& held, std::uint32_t press, bool caught_up);
+    // The last frame showed a press: this one shows it released (take no event).
+    bool releasing() const { return press_ != 0; }
+    bool is_open() const { return open_; }
+    void set_open(bool open);
+    // A configuration the writer thread has accepted (a file edit, or ours).
+    void adopt(const SimConfig& accepted);
+    // An edit waiting to be handed over; true once per edit.
+    bool take_edit(AppConfig& out);
+    const AppConfig& working() const { return working_; }
+    const std::string& save_path() const { return save_path_; }
+    const std::string& message() const { return message_; }
+
+    // What a slider or a reset button does: sets table.key to the value's TOML
+    // text. False (message() says why) when the schema or a relation refuses it.
+    bool edit(std::string_view table, std::string_view key, const std::string& value_text);
+    bool reset(const PanelKey& key);
+    // Writes the edited keys into `path` (made when missing). False, with the
+    // reason in message(), when it cannot.
+    bool save(const std::string& path);
+
+    void draw(std::int32_t width, std::int32_t height, float dt_s) override;
+    void recreate() override;
+    bool on_native_event(const void* event) override;
+
+private:
+    void feed_navigation();
+    void draw_panel(float width, float height);
+    void draw_row(std::size_t index);
+    void say(const std::string& line, bool problem);
+
+    render::Platform& platform_;
+    TuningUiOptions options_;
+    AppConfig defaults_;
+    AppConfig working_;
+    std::vector<PanelKey> keys_;
+    std::vector<std::string> edited_;  // "table.key", in the order first edited
+    bool pending_ = false;
+    bool open_ = false;
+    bool focus_first_ = false;  // just opened: the pad starts on the first editable slider
+    int focus_frames_ = 0;
+    std::size_t first_editable_ = 0;
+    bool sdl_ = false;
+    ImGuiContext* context_ = nullptr;
+    std::unique_ptr<render::ImGuiGles3Renderer> renderer_;
+    TickInput pad_{};
+    std::uint32_t press_ = 0;     // this frame's press event
+    bool caught_up_ = true;
+    std::string save_path_;
+    std::array<char, 512> path_buffer_{};
+    std::string message_;
+    bool message_problem_ = false;
+};
+
+}  // namespace marionette::ui

@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# The tuning UI end to end under Xvfb (docs/ui.md): `run` in an SDL window with
+# a simulated pad whose program opens the UI by the chord back + start, moves
+# the gait's step-length slider with the d-pad, saves with north and closes the
+# UI; the saved TOML has the new value and the old comments, the log records
+# the edit as a configuration change, and `replay` gives the run's final hash.
+# Usage: ui_xvfb_tests.sh MARIONETTE_BINARY
+set -u
+bin=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work"
+passes=0
+failures=0
+check() {
+  local what=$1
+  shift
+  if "$@"; then passes=$((passes + 1)); else failures=$((failures + 1)); echo "FAIL: $what"; fi
+}
+if ! command -v xvfb-run >/dev/null; then
+  echo "xvfb-run is not installed (scripts/setup.sh installs it)"
+  exit 1
+fi
+
+cat >tuned.toml <<'TOML'
+# my walk, tuned on the screen
+[gait]                      # the spline-IK walk
+walk_duty = 0.58            # planted a little longer
+step_length_multiplier = 0.45   # stride
+TOML
+cp tuned.toml original.toml
+# A small window without MSAA: llvmpipe draws it in a few ms on an idle machine.
+# (run reads render.toml from the user's configuration folder.)
+mkdir -p home/.config/marionette
+printf '[display]\nwidth = 640\nheight = 400\nmsaa_samples = 0\n' >home/.config/marionette/render.toml
+
+# Presses are 0.8 s apart: a frame on llvmpipe under load takes up to a few
+# hundred ms, and each press must be seen down in one frame and up in the next.
+cat >ui.prog <<'PROG'
+hold 1s
+press back+start 200ms
+hold 800ms
+press dpad_down 150ms
+hold 800ms
+press south 150ms
+hold 800ms
+press dpad_right 150ms
+hold 800ms
+press dpad_right 150ms
+hold 800ms
+press south 150ms
+hold 800ms
+press north 150ms
+hold 1s
+press back+start 200ms
+hold 500ms
+ramp 300ms ly=1
+hold 1.5s
+ramp 300ms ly=0
+hold 1s
+PROG
+
+HOME=$work/home XDG_CONFIG_HOME=$work/home/.config LIBGL_ALWAYS_SOFTWARE=1 xvfb-run -a -s "-screen 0 800x600x24" "$bin" run --display window --input sim:ui.prog --duration 14 \
+  --config tuned.toml --record ui.mlog --stats-json stats.json >run.txt 2>run.err
+code=$?
+check "run under Xvfb exits 0 (got $code)" test $code -eq 0
+check "the chord opened the UI" grep -q "^ui: opened" run.txt
+check "the d-pad moved gait.step_length_multiplier up" grep -Eq "^ui: gait.step_length_multiplier 0\.4[0-9]* -> 0\.4[6-9]" run.txt
+check "north saved the file" grep -q "^ui: saved 1 edited key(s) to tuned.toml" run.txt
+check "the chord closed the UI" grep -q "^ui: closed" run.txt
+check "the edit was applied at a tick boundary" grep -q "config: applied before tick" run.txt
+value=$(sed -nE 's/^step_length_multiplier = ([0-9.]+)   # stride$/\1/p' tuned.toml)
+check "the saved TOML has the new value ($value) with its comment" awk -v v="$value" 'BEGIN { exit !(v > 0.46 && v < 0.5) }'
+check "the saved TOML keeps the other lines" bash -c "diff <(grep -v '^step_length_multiplier' original.toml) <(grep -v '^step_length_multiplier' tuned.toml)"
+hash=$(sed -E 's/.*"final_hash":"([0-9a-f]+)".*/\1/' stats.json)
+check "replay of the recording gives the run's final hash ($hash)" test "$hash" = "$("$bin" replay ui.mlog --hash)"
+check "the run says it applied a configuration change" grep -q '"config_changes":[1-9]' stats.json
+grep -E "^(ui|config): " run.txt
+echo "saved: $(grep '^step_length_multiplier' tuned.toml); final hash $hash"
+if ((failures > 0)); then
+  echo "--- run.txt"; cat run.txt; echo "--- run.err"; cat run.err; echo "--- tuned.toml"; cat tuned.toml
+fi
+echo "$passes passed, $failures failed"
+[[ $failures -eq 0 ]]
