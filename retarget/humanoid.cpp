@@ -376,7 +376,10 @@ const std::array<int, kRoleCount>& child_roles() {
 void apply_map(const Skeleton& s, const RetargetMap& map, HumanoidChains& h) {
     const auto& names = role_names();
     for (size_t i = 0; i < map.roles.size(); ++i) {
-        const auto& [role_name, joint_name] = map.roles[i];
+        // Plain references, not a structured binding: Clang 14 cannot capture a
+        // structured binding in the lambda below (C++20 allows it; CI builds with Clang 14).
+        const auto& role_name = map.roles[i].first;
+        const auto& joint_name = map.roles[i].second;
         const int role = static_cast<int>(std::find_if(names.begin(), names.end(), [&](const char* n) { return role_name == n; }) - names.begin());
         const int j = s.find(joint_name);
         if (j < 0)
