@@ -10,17 +10,6 @@ namespace marionette::retarget::detail {
 
 namespace {
 
-size_t at(int frame, int joints, int j) {
-    return static_cast<size_t>(frame) * static_cast<size_t>(joints) + static_cast<size_t>(j);
-}
-
-bool unit(vec3 v, vec3& out) {
-    const float l = std::sqrt(glm::dot(v, v));
-    if (!(l > 1e-8f)) return false;
-    out = v / l;
-    return true;
-}
-
 const int kFootRole[2] = {role::foot_l, role::foot_r};
 
 // Per frame and foot: 0 free, 1 ankle planted, 2 ball planted (heel lifted).

@@ -10,20 +10,12 @@
 
 namespace marionette::retarget {
 
+using detail::at;
+using detail::unit;
+
 namespace {
 
 const vec3 kUp(0.0f, 1.0f, 0.0f);
-
-size_t at(int frame, int joints, int j) {
-    return static_cast<size_t>(frame) * static_cast<size_t>(joints) + static_cast<size_t>(j);
-}
-
-bool unit(vec3 v, vec3& out) {
-    const float l = std::sqrt(glm::dot(v, v));
-    if (!(l > 1e-8f)) return false;
-    out = v / l;
-    return true;
-}
 
 // Rotation about +Y taking the horizontal part of `a` onto that of `b`.
 quat yaw_from_to(vec3 a, vec3 b) {

@@ -3,6 +3,9 @@
 #include "retarget/pose_space.hpp"
 #include "retarget/retarget.hpp"
 
+#include <cmath>
+#include <cstddef>
+
 namespace marionette::retarget::detail {
 
 // Source positions → the puppet's world: the ground to y = 0, turned so the
@@ -13,6 +16,19 @@ struct SourceToPuppet {
     float floor = 0.0f;
     vec3 apply(vec3 p) const { return scale * quat_rotate(yaw, p - vec3(0.0f, floor, 0.0f)); }
 };
+
+// Index of joint j of frame `frame` in a frame-major array of `joints` per frame.
+inline std::size_t at(int frame, int joints, int j) {
+    return static_cast<std::size_t>(frame) * static_cast<std::size_t>(joints) + static_cast<std::size_t>(j);
+}
+
+// `v` normalised into `out`; false (out untouched) for a (near-)zero vector.
+inline bool unit(vec3 v, vec3& out) {
+    const float l = std::sqrt(glm::dot(v, v));
+    if (!(l > 1e-8f)) return false;
+    out = v / l;
+    return true;
+}
 
 inline vec3 point_of(const ModelFrames& m, int f, SourcePoint s) { return lerp(m.position(f, s.a), m.position(f, s.b), s.t); }
 
