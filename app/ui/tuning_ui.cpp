@@ -246,6 +246,8 @@ void TuningUi::feed_navigation() {
     if (press_ & button_bit(Button::north)) save(std::string(path_buffer_.data()));
 }
 
+constexpr float kMaxUiFrameS = 1.0f / 30.0f;  // s: the longest frame ImGui is told of
+
 void TuningUi::draw(std::int32_t width, std::int32_t height, float dt_s) {
     if (!open_) return;
     ImGui::SetCurrentContext(context_);
@@ -260,7 +262,10 @@ void TuningUi::draw(std::int32_t width, std::int32_t height, float dt_s) {
     }
     io.DisplaySize = ImVec2(static_cast<float>(width), static_cast<float>(height));
     io.DisplayFramebufferScale = ImVec2(1.0f, 1.0f);
-    io.DeltaTime = std::max(dt_s, 1e-4f);
+    // ImGui times a held d-pad's repeat by summing frame times while it is down.
+    // A stalled frame (llvmpipe under load: 100+ ms) would count as a long hold
+    // and turn one tap into a repeat, so a frame counts as at most 1/30 s.
+    io.DeltaTime = std::clamp(dt_s, 1e-4f, kMaxUiFrameS);
     feed_navigation();
     ImGui::NewFrame();
     draw_panel(static_cast<float>(width), static_cast<float>(height));
