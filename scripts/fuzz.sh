@@ -13,7 +13,11 @@
 # for one input) or an allocation over -malloc_limit_mb; the reproducer is
 # left in build/fuzz/findings/<target>/ and the log in build/fuzz/run/<target>.log.
 # Prints each target's executions and final coverage (cov: edges, ft: features).
-# Targets run FUZZ_JOBS at a time (default: the number of cores). FUZZ_TIMEOUT
+# Targets run FUZZ_JOBS at a time (default: the number of cores). FUZZ_RUNS=N
+# also stops each target after N executions (the issue's long campaign is
+# `FUZZ_RUNS=10000000 scripts/fuzz.sh 1800`: 10 million executions or 30 minutes,
+# whichever comes first); the table then shows each target's CPU seconds, so a
+# run on a busy machine can be read honestly. FUZZ_TIMEOUT
 # overrides every target's per-input limit (libFuzzer's -timeout is wall-clock
 # time, so a heavily loaded machine can turn a 5 ms input into a false timeout:
 # re-run the reproducer alone, `build/fuzz/tests/fuzz/fuzz_<target> FILE`, before
@@ -64,6 +68,16 @@ findings=build/fuzz/findings
 rm -rf "$run" "$findings"
 mkdir -p "$run" "$findings"
 
+# User + system CPU seconds of this shell's finished children (each run_one runs
+# in its own subshell, so the difference around the fuzzer is the fuzzer's).
+cpu_seconds_of_children() {
+  local t
+  t=$(times | tail -1)
+  awk -v t="$t" 'BEGIN { n = split(t, f, " "); s = 0
+    for (i = 1; i <= n; i++) { split(f[i], ms, "m"); sub("s", "", ms[2]); s += ms[1] * 60 + ms[2] }
+    printf "%.1f\n", s }'
+}
+
 run_one() {
   local name=$1 max_len=$2 timeout=$3 dict=$4
   local exe="$bin/fuzz_$name" work="$run/$name" log="$run/$name.log"
@@ -73,9 +87,13 @@ run_one() {
   local args=(-max_total_time="$seconds" -max_len="$max_len" -timeout="${FUZZ_TIMEOUT:-$timeout}" -rss_limit_mb=2048
               -malloc_limit_mb=512 -print_final_stats=1 -artifact_prefix="$findings/$name/")
   [[ "$dict" != - ]] && args+=(-dict="tests/fuzz/dict/$dict")
-  local rc=0
+  [[ -n "${FUZZ_RUNS:-}" ]] && args+=(-runs="$FUZZ_RUNS")
+  local rc=0 t0 t1
+  t0=$(cpu_seconds_of_children)
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 "$exe" "${args[@]}" "$work" "${seeds[@]}" >"$log" 2>&1 || rc=$?
+  t1=$(cpu_seconds_of_children)
   echo "$rc" >"$run/$name.rc"
+  awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.0f\n", b - a }' >"$run/$name.cpu"
   if ((grow)) && [[ "$rc" == 0 ]]; then
     "$exe" -merge=1 -max_len="$max_len" "tests/fuzz/corpus/$name" "$work" >>"$log" 2>&1
   fi
@@ -98,7 +116,7 @@ done
 wait
 
 failed=0
-printf '%-15s %12s %8s %8s %7s %7s  %s\n' target executions exec/s cov ft rss_mb result
+printf '%-15s %12s %8s %7s %8s %7s %7s  %s\n' target executions exec/s cpu_s cov ft rss_mb result
 for t in "${selected[@]}"; do
   read -r name _ <<<"$t"
   log="$run/$name.log"
@@ -106,6 +124,7 @@ for t in "${selected[@]}"; do
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   speed=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
   rss=$(sed -n 's/^stat::peak_rss_mb: *//p' "$log" | tail -1)
+  cpu=$(cat "$run/$name.cpu" 2>/dev/null || echo '?')
   # The last status line ("#N DONE cov: X ft: Y ..." or the last pulse) holds the final coverage.
   cov=$(grep -E '^#[0-9]+' "$log" | grep -o 'cov: [0-9]*' | tail -1 | cut -d' ' -f2)
   ft=$(grep -E '^#[0-9]+' "$log" | grep -o 'ft: [0-9]*' | tail -1 | cut -d' ' -f2)
@@ -114,7 +133,7 @@ for t in "${selected[@]}"; do
     result="FINDING (exit $rc): $(ls -t "$findings/$name" | head -1) — see $log"
     failed=1
   fi
-  printf '%-15s %12s %8s %8s %7s %7s  %s\n' "$name" "${execs:-?}" "${speed:-?}" "${cov:-?}" "${ft:-?}" "${rss:-?}" "$result"
+  printf '%-15s %12s %8s %7s %8s %7s %7s  %s\n' "$name" "${execs:-?}" "${speed:-?}" "$cpu" "${cov:-?}" "${ft:-?}" "${rss:-?}" "$result"
 done
 end=$(date +%s)
 echo "== fuzz: build $((built - start)) s, fuzzing $((end - built)) s, total $((end - start)) s"
