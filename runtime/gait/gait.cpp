@@ -271,6 +271,7 @@ float max_swing_side(const GaitRig& rig) {
 
 constexpr float kRiserM = 0.01f;             // m: ground this much above the foot's spot next to it is a riser
 constexpr float kLiftOffClearanceM = 0.005f;  // m: the straight lift-off and set-down away from risers
+constexpr float kMaxPathGrade = 1.0f;          // rise (or fall) per metre of travel toward (or from) a high key, at most
 
 // The swing path (docs/gait.md): the ankle's height at evenly spaced fractions
 // s of the step's horizontal distance, as a monotone cubic Hermite spline in the
@@ -353,6 +354,17 @@ void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, 
             if (!(ground[next] > ground[k] + kRiserM)) floor = ground[k] + rig.ankle_height + kLiftOffClearanceM;
         }
         f.path_height[k] = maxf(shaped, floor);
+    }
+    // The path climbs toward a high key no steeper than kMaxPathGrade and falls
+    // from one no steeper either: an edge's clearance is met by a ramp, not by a
+    // plateau and a wall (that kink snapped the knee at speed, up a flight).
+    const float travel = swing_travel(f, rig);
+    for (int i = 1; i + 1 < n; ++i) {
+        const std::size_t k = static_cast<std::size_t>(i);
+        for (int jj = 1; jj + 1 < n; ++jj) {
+            const float d = std::fabs(key_reach(i) - key_reach(jj)) * travel;
+            f.path_height[k] = maxf(f.path_height[k], f.path_height[static_cast<std::size_t>(jj)] - kMaxPathGrade * d);
+        }
     }
     std::array<HermiteKey, kSwingPathKeys> keys{};
     swing_path_keys(f, rig, keys);
@@ -523,6 +535,7 @@ Placement plan_target(const GaitState& g, const GaitTick& t, int foot, vec3 root
 constexpr float kShortestSwing = 0.12f;           // s: a late lift-off still swings this long
 constexpr float kWristDrag = 0.4f;                // hand tilt against its path's velocity, per m/cycle
 constexpr float kMaxPelvisVerticalSpeed = 0.9f;   // m/s the pelvis follows its height target at, at most
+constexpr float kSoftLeadShare = 0.5f;            // a landing's pelvis height is reached by this share of the swing left
 
 // Standing spot for a foot beside the other (planted) foot.
 Placement stop_target(const GaitState& g, int foot, float heading, const GaitRig& rig, const Terrain& terrain) {
@@ -958,6 +971,7 @@ float hip_drop(float horizontal2, float reach2) { return std::sqrt(maxf(reach2 -
 struct PelvisLimits {
     float hard = kNoLimitM;  // m: keeps every ankle within its reach now
     float soft = kNoLimitM;  // m: keeps each swing's landing within the planted reach
+    float soft_time = 0.0f;  // s: until the swing that sets `soft` lands
 };
 
 // Planted feet bind exactly (within the IK's exact zone). A swinging foot binds
@@ -984,7 +998,11 @@ PelvisLimits pelvis_limits(const GaitState& g, const GaitTick& t, vec3 pelvis) {
         limit.hard = minf(limit.hard, f.ankle.y + hip_drop(dx * dx + dz * dz, swing_reach * swing_reach));
         const vec3 hip_then = hip_at_landing(f, g, t, pelvis, i);
         const float tx = f.target.x - hip_then.x, tz = f.target.z - hip_then.z;
-        limit.soft = minf(limit.soft, f.target.y + hip_drop(tx * tx + tz * tz, reach2));
+        const float soft = f.target.y + hip_drop(tx * tx + tz * tz, reach2);
+        if (soft < limit.soft) {
+            limit.soft = soft;
+            limit.soft_time = maxf(0.0f, 1.0f - f.progress) / swing_rate(f, t);
+        }
     }
     return limit;
 }
@@ -996,8 +1014,15 @@ void place_pelvis(GaitState& g, const GaitTick& t, vec3 root, float breath_time)
     const PelvisLimits limit = pelvis_limits(g, t, pelvis);
     const float previous_y = g.pelvis.y;
     const float max_move = kMaxPelvisVerticalSpeed * t.dt;
+    // Lowering toward a swing's landing goes faster than kMaxPelvisVerticalSpeed
+    // when that would not get there before the foot lands (a run down a flight):
+    // fast enough to arrive kSoftLeadShare of the way through the time left, so
+    // the hard limit never has to pull the pelvis down in a few ticks.
+    float max_drop = max_move;
+    if (limit.soft < previous_y && limit.soft_time > t.dt)
+        max_drop = maxf(max_drop, (previous_y - limit.soft) / (kSoftLeadShare * limit.soft_time) * t.dt);
     pelvis.y = minf(pelvis.y, limit.soft);
-    pelvis.y = clampf(pelvis.y, previous_y - max_move, previous_y + max_move);
+    pelvis.y = clampf(pelvis.y, previous_y - max_drop, previous_y + max_move);
     pelvis.y = minf(pelvis.y, limit.hard);
     g.pelvis = pelvis;
 }
