@@ -958,6 +958,7 @@ float hip_drop(float horizontal2, float reach2) { return std::sqrt(maxf(reach2 -
 struct PelvisLimits {
     float hard = kNoLimitM;  // m: keeps every ankle within its reach now
     float soft = kNoLimitM;  // m: keeps each swing's landing within the planted reach
+    float descent = 0.0f;    // m/s: how fast the pelvis must sink to meet the soft limit by the swing's landing
 };
 
 // Planted feet bind exactly (within the IK's exact zone). A swinging foot binds
@@ -984,20 +985,28 @@ PelvisLimits pelvis_limits(const GaitState& g, const GaitTick& t, vec3 pelvis) {
         limit.hard = minf(limit.hard, f.ankle.y + hip_drop(dx * dx + dz * dz, swing_reach * swing_reach));
         const vec3 hip_then = hip_at_landing(f, g, t, pelvis, i);
         const float tx = f.target.x - hip_then.x, tz = f.target.z - hip_then.z;
-        limit.soft = minf(limit.soft, f.target.y + hip_drop(tx * tx + tz * tz, reach2));
+        const float soft = f.target.y + hip_drop(tx * tx + tz * tz, reach2);
+        limit.soft = minf(limit.soft, soft);
+        const float remaining = maxf(t.dt, maxf(0.0f, 1.0f - f.progress) / swing_rate(f, t));
+        limit.descent = maxf(limit.descent, (g.pelvis.y - soft) / remaining);
     }
     return limit;
 }
 
 // The pelvis: its unlimited place, lowered to the soft limit at no more than
-// kMaxPelvisVerticalSpeed, and never above the hard limit.
+// kMaxPelvisVerticalSpeed, or faster where a swing needs it to meet the soft
+// limit by its landing (evenly over the time left: held to 0.9 m/s, the pelvis
+// arrived late and the hard limit dropped it by up to 3 cm a tick just before
+// touchdown, spinning the shin: hillside × circle 2865 °/s), and never above
+// the hard limit.
 void place_pelvis(GaitState& g, const GaitTick& t, vec3 root, float breath_time) {
     vec3 pelvis = unlimited_pelvis(g, t, root, breath_time);
     const PelvisLimits limit = pelvis_limits(g, t, pelvis);
     const float previous_y = g.pelvis.y;
     const float max_move = kMaxPelvisVerticalSpeed * t.dt;
+    const float max_sink = maxf(kMaxPelvisVerticalSpeed, limit.descent) * t.dt;
     pelvis.y = minf(pelvis.y, limit.soft);
-    pelvis.y = clampf(pelvis.y, previous_y - max_move, previous_y + max_move);
+    pelvis.y = clampf(pelvis.y, previous_y - max_sink, previous_y + max_move);
     pelvis.y = minf(pelvis.y, limit.hard);
     g.pelvis = pelvis;
 }
