@@ -643,6 +643,7 @@ constexpr float kMinHipDropShareSq = 0.09f;        // the hip stays at least 0.3
 constexpr float kEarlyLiftPhase = 0.05f;          // … at most this much of a cycle before its duty factor
 constexpr float kEarlyLiftReachShare = 0.9f;      // a planted foot this share of the leg reach behind its hip lifts
 constexpr float kEarlyLiftStanceShare = 0.95f;    // … or this share of kStanceReachM (before the root pivots on it)
+constexpr float kSinkByProgress = 1.0f;            // a swing's soft limit is met by this progress (before the set-down)
 constexpr float kNoLimitM = 1e9f;                  // m: a pelvis height limit that no foot imposes
 
 // The stick's command this tick.
@@ -951,6 +952,30 @@ vec3 unlimited_pelvis(const GaitState& g, const GaitTick& t, vec3 root, float br
     return pelvis;
 }
 
+// Where a swing's hip will be at landing, as hip_at_landing, but walking (the
+// other foot stays planted until this one lands) the root pivots on that
+// planted foot (keep_stance_in_reach): it goes no further along the heading than
+// keeps the other hip within kStanceReachM of its foot (or as far as it is now).
+// Predicted without that, the pelvis met the soft limit late when the root
+// stalled on the planted foot and then dropped onto the hard limit.
+vec3 hip_at_landing_in_reach(const FootState& f, const GaitState& g, const GaitTick& t, vec3 pelvis, int i) {
+    const vec3 hip_then = hip_at_landing(f, g, t, pelvis, i);
+    const int j = 1 - i;
+    const FootState& other = g.feet[static_cast<std::size_t>(j)];
+    if (other.swinging || running(t.c, g.speed)) return hip_then;
+    const vec3 hip = pelvis + t.h.left * (side_sign(i) * t.rig.hip_half_width);
+    const vec3 other_hip = pelvis + t.h.left * (side_sign(j) * t.rig.hip_half_width);
+    const float px = other_hip.x - other.ankle.x, pz = other_hip.z - other.ankle.z;
+    const float b = px * t.h.forward.x + pz * t.h.forward.z;
+    const float p2 = px * px + pz * pz;
+    const float r = maxf(kStanceReachM, std::sqrt(p2));
+    const float most = -b + std::sqrt(maxf(0.0f, b * b - (p2 - r * r)));
+    const float ahead = (hip_then.x - hip.x) * t.h.forward.x + (hip_then.z - hip.z) * t.h.forward.z;
+    if (ahead <= most) return hip_then;
+    const float back = ahead - maxf(0.0f, most);
+    return hip_then - t.h.forward * back;
+}
+
 // How far below the hip an ankle at squared horizontal distance horizontal2 is,
 // for a squared hip–ankle reach2 (at least 0.3 of the reach).
 float hip_drop(float horizontal2, float reach2) { return std::sqrt(maxf(reach2 - horizontal2, kMinHipDropShareSq * reach2)); }
@@ -983,11 +1008,11 @@ PelvisLimits pelvis_limits(const GaitState& g, const GaitTick& t, vec3 pelvis) {
         // neither lifting nor landing changes the limit in one tick.
         const float swing_reach = rig.leg_reach + (full_reach - rig.leg_reach) * swing_reach_bump(f.progress, f.reach_carry);
         limit.hard = minf(limit.hard, f.ankle.y + hip_drop(dx * dx + dz * dz, swing_reach * swing_reach));
-        const vec3 hip_then = hip_at_landing(f, g, t, pelvis, i);
+        const vec3 hip_then = hip_at_landing_in_reach(f, g, t, pelvis, i);
         const float tx = f.target.x - hip_then.x, tz = f.target.z - hip_then.z;
         const float soft = f.target.y + hip_drop(tx * tx + tz * tz, reach2);
         limit.soft = minf(limit.soft, soft);
-        const float remaining = maxf(t.dt, maxf(0.0f, 1.0f - f.progress) / swing_rate(f, t));
+        const float remaining = maxf(t.dt, maxf(0.0f, kSinkByProgress - f.progress) / swing_rate(f, t));
         limit.descent = maxf(limit.descent, (g.pelvis.y - soft) / remaining);
     }
     return limit;
