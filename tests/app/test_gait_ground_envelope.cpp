@@ -195,10 +195,9 @@ struct KnownFailure {
     std::uint64_t seed;
 };
 constexpr KnownFailure kKnownFailures[] = {
-    // stairs
-    {Ground::stairs, 4}, {Ground::stairs, 6}, {Ground::stairs, 10}, {Ground::stairs, 11}, {Ground::stairs, 13}, {Ground::stairs, 15}, {Ground::stairs, 21}, {Ground::stairs, 27}, {Ground::stairs, 40}, {Ground::stairs, 44}, {Ground::stairs, 54}, {Ground::stairs, 78}, {Ground::stairs, 86}, {Ground::stairs, 89}, {Ground::stairs, 93}, {Ground::stairs, 95},
-    // curb
-    {Ground::curb, 74},
+    // stairs (the other 14 stairs seeds and curb seed 74 meet every limit since
+    // the pelvis sinks in time for a landing, and are kept as regressions)
+    {Ground::stairs, 6}, {Ground::stairs, 40},
 };
 bool known_failure(Ground kind, std::uint64_t seed) {
     for (const KnownFailure& k : kKnownFailures)
@@ -230,7 +229,7 @@ void check_kind(Ground kind, const char* name, std::initializer_list<std::uint64
 }  // namespace
 
 TEST_CASE("gait ground envelope: generated stairs, up and down, at any angle to 60 degrees", "[gait_ground]") {
-    check_kind(Ground::stairs, "stairs", {37, 52});
+    check_kind(Ground::stairs, "stairs", {37, 52, 4, 10, 11, 13, 15, 21, 27, 44, 54, 78, 86, 89, 93, 95});
 }
 
 TEST_CASE("gait ground envelope: generated ramps and hillsides to 30 degrees, at any heading", "[gait_ground]") {
@@ -242,7 +241,7 @@ TEST_CASE("gait ground envelope: generated heightfields with 30 cm of relief", "
 }
 
 TEST_CASE("gait ground envelope: generated curbs and ledges to 0.35 m", "[gait_ground]") {
-    check_kind(Ground::curb, "curbs and ledges", {});
+    check_kind(Ground::curb, "curbs and ledges", {74});
 }
 
 TEST_CASE("gait ground envelope: generated cases that still exceed a limit (regressions, reported)", "[gait_ground][!mayfail]") {
