@@ -643,7 +643,7 @@ constexpr float kMinHipDropShareSq = 0.09f;        // the hip stays at least 0.3
 constexpr float kEarlyLiftPhase = 0.05f;          // … at most this much of a cycle before its duty factor
 constexpr float kEarlyLiftReachShare = 0.9f;      // a planted foot this share of the leg reach behind its hip lifts
 constexpr float kEarlyLiftStanceShare = 0.95f;    // … or this share of kStanceReachM (before the root pivots on it)
-constexpr float kSinkByProgress = 1.0f;            // a swing's soft limit is met by this progress (before the set-down)
+constexpr float kSinkByProgress = 0.95f;           // a swing's soft limit is met by this progress, just before touchdown
 constexpr float kNoLimitM = 1e9f;                  // m: a pelvis height limit that no foot imposes
 
 // The stick's command this tick.
@@ -1020,10 +1020,10 @@ PelvisLimits pelvis_limits(const GaitState& g, const GaitTick& t, vec3 pelvis) {
 
 // The pelvis: its unlimited place, lowered to the soft limit at no more than
 // kMaxPelvisVerticalSpeed, or faster where a swing needs it to meet the soft
-// limit by its landing (evenly over the time left: held to 0.9 m/s, the pelvis
-// arrived late and the hard limit dropped it by up to 3 cm a tick just before
-// touchdown, spinning the shin: hillside × circle 2865 °/s), and never above
-// the hard limit.
+// limit by kSinkByProgress of its swing (evenly over the time left: held to
+// 0.9 m/s, the pelvis arrived late and the hard limit dropped it by up to 3 cm
+// a tick just before touchdown, spinning the shin: hillside × circle
+// 2865 °/s), and never above the hard limit.
 void place_pelvis(GaitState& g, const GaitTick& t, vec3 root, float breath_time) {
     vec3 pelvis = unlimited_pelvis(g, t, root, breath_time);
     const PelvisLimits limit = pelvis_limits(g, t, pelvis);
