@@ -535,7 +535,6 @@ Placement plan_target(const GaitState& g, const GaitTick& t, int foot, vec3 root
 constexpr float kShortestSwing = 0.12f;           // s: a late lift-off still swings this long
 constexpr float kWristDrag = 0.4f;                // hand tilt against its path's velocity, per m/cycle
 constexpr float kMaxPelvisVerticalSpeed = 0.9f;   // m/s the pelvis follows its height target at, at most
-constexpr float kSoftLeadShare = 0.5f;            // a landing's pelvis height is reached by this share of the swing left
 
 // Standing spot for a foot beside the other (planted) foot.
 Placement stop_target(const GaitState& g, int foot, float heading, const GaitRig& rig, const Terrain& terrain) {
@@ -656,6 +655,7 @@ constexpr float kMinHipDropShareSq = 0.09f;        // the hip stays at least 0.3
 constexpr float kEarlyLiftPhase = 0.05f;          // … at most this much of a cycle before its duty factor
 constexpr float kEarlyLiftReachShare = 0.9f;      // a planted foot this share of the leg reach behind its hip lifts
 constexpr float kEarlyLiftStanceShare = 0.95f;    // … or this share of kStanceReachM (before the root pivots on it)
+constexpr float kSinkByProgress = 0.95f;           // a swing's soft limit is met by this progress, just before touchdown
 constexpr float kNoLimitM = 1e9f;                  // m: a pelvis height limit that no foot imposes
 
 // The stick's command this tick.
@@ -964,6 +964,30 @@ vec3 unlimited_pelvis(const GaitState& g, const GaitTick& t, vec3 root, float br
     return pelvis;
 }
 
+// Where a swing's hip will be at landing, as hip_at_landing, but walking (the
+// other foot stays planted until this one lands) the root pivots on that
+// planted foot (keep_stance_in_reach): it goes no further along the heading than
+// keeps the other hip within kStanceReachM of its foot (or as far as it is now).
+// Predicted without that, the pelvis met the soft limit late when the root
+// stalled on the planted foot and then dropped onto the hard limit.
+vec3 hip_at_landing_in_reach(const FootState& f, const GaitState& g, const GaitTick& t, vec3 pelvis, int i) {
+    const vec3 hip_then = hip_at_landing(f, g, t, pelvis, i);
+    const int j = 1 - i;
+    const FootState& other = g.feet[static_cast<std::size_t>(j)];
+    if (other.swinging || running(t.c, g.speed)) return hip_then;
+    const vec3 hip = pelvis + t.h.left * (side_sign(i) * t.rig.hip_half_width);
+    const vec3 other_hip = pelvis + t.h.left * (side_sign(j) * t.rig.hip_half_width);
+    const float px = other_hip.x - other.ankle.x, pz = other_hip.z - other.ankle.z;
+    const float b = px * t.h.forward.x + pz * t.h.forward.z;
+    const float p2 = px * px + pz * pz;
+    const float r = maxf(kStanceReachM, std::sqrt(p2));
+    const float most = -b + std::sqrt(maxf(0.0f, b * b - (p2 - r * r)));
+    const float ahead = (hip_then.x - hip.x) * t.h.forward.x + (hip_then.z - hip.z) * t.h.forward.z;
+    if (ahead <= most) return hip_then;
+    const float back = ahead - maxf(0.0f, most);
+    return hip_then - t.h.forward * back;
+}
+
 // How far below the hip an ankle at squared horizontal distance horizontal2 is,
 // for a squared hip–ankle reach2 (at least 0.3 of the reach).
 float hip_drop(float horizontal2, float reach2) { return std::sqrt(maxf(reach2 - horizontal2, kMinHipDropShareSq * reach2)); }
@@ -971,7 +995,7 @@ float hip_drop(float horizontal2, float reach2) { return std::sqrt(maxf(reach2 -
 struct PelvisLimits {
     float hard = kNoLimitM;  // m: keeps every ankle within its reach now
     float soft = kNoLimitM;  // m: keeps each swing's landing within the planted reach
-    float soft_time = 0.0f;  // s: until the swing that sets `soft` lands
+    float descent = 0.0f;    // m/s: how fast the pelvis must sink to meet the soft limit by the swing's landing
 };
 
 // Planted feet bind exactly (within the IK's exact zone). A swinging foot binds
@@ -996,33 +1020,30 @@ PelvisLimits pelvis_limits(const GaitState& g, const GaitTick& t, vec3 pelvis) {
         // neither lifting nor landing changes the limit in one tick.
         const float swing_reach = rig.leg_reach + (full_reach - rig.leg_reach) * swing_reach_bump(f.progress, f.reach_carry);
         limit.hard = minf(limit.hard, f.ankle.y + hip_drop(dx * dx + dz * dz, swing_reach * swing_reach));
-        const vec3 hip_then = hip_at_landing(f, g, t, pelvis, i);
+        const vec3 hip_then = hip_at_landing_in_reach(f, g, t, pelvis, i);
         const float tx = f.target.x - hip_then.x, tz = f.target.z - hip_then.z;
         const float soft = f.target.y + hip_drop(tx * tx + tz * tz, reach2);
-        if (soft < limit.soft) {
-            limit.soft = soft;
-            limit.soft_time = maxf(0.0f, 1.0f - f.progress) / swing_rate(f, t);
-        }
+        limit.soft = minf(limit.soft, soft);
+        const float remaining = maxf(t.dt, maxf(0.0f, kSinkByProgress - f.progress) / swing_rate(f, t));
+        limit.descent = maxf(limit.descent, (g.pelvis.y - soft) / remaining);
     }
     return limit;
 }
 
 // The pelvis: its unlimited place, lowered to the soft limit at no more than
-// kMaxPelvisVerticalSpeed, and never above the hard limit.
+// kMaxPelvisVerticalSpeed, or faster where a swing needs it to meet the soft
+// limit by kSinkByProgress of its swing (evenly over the time left: held to
+// 0.9 m/s, the pelvis arrived late and the hard limit dropped it by up to 3 cm
+// a tick just before touchdown, spinning the shin: hillside × circle
+// 2865 °/s), and never above the hard limit.
 void place_pelvis(GaitState& g, const GaitTick& t, vec3 root, float breath_time) {
     vec3 pelvis = unlimited_pelvis(g, t, root, breath_time);
     const PelvisLimits limit = pelvis_limits(g, t, pelvis);
     const float previous_y = g.pelvis.y;
     const float max_move = kMaxPelvisVerticalSpeed * t.dt;
-    // Lowering toward a swing's landing goes faster than kMaxPelvisVerticalSpeed
-    // when that would not get there before the foot lands (a run down a flight):
-    // fast enough to arrive kSoftLeadShare of the way through the time left, so
-    // the hard limit never has to pull the pelvis down in a few ticks.
-    float max_drop = max_move;
-    if (limit.soft < previous_y && limit.soft_time > t.dt)
-        max_drop = maxf(max_drop, (previous_y - limit.soft) / (kSoftLeadShare * limit.soft_time) * t.dt);
+    const float max_sink = maxf(kMaxPelvisVerticalSpeed, limit.descent) * t.dt;
     pelvis.y = minf(pelvis.y, limit.soft);
-    pelvis.y = clampf(pelvis.y, previous_y - max_drop, previous_y + max_move);
+    pelvis.y = clampf(pelvis.y, previous_y - max_sink, previous_y + max_move);
     pelvis.y = minf(pelvis.y, limit.hard);
     g.pelvis = pelvis;
 }
