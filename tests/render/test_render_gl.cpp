@@ -372,7 +372,7 @@ TEST_CASE("the tuning UI takes each pad press as one step, with 0 ms and 500 ms 
     auto tap = [&](Button b) {
         frame(button_bit(b), 3);
         for (int i = 0; i < 5; ++i) frame(button_bit(b), 3);
-        for (int i = 0; i < 4; ++i) frame(0, 10);
+        for (int i = 0; i < 2; ++i) frame(0, 10);
     };
     frame(0, 1);
     frame(ui::kUiChord, 1);
@@ -392,12 +392,13 @@ TEST_CASE("the tuning UI takes each pad press as one step, with 0 ms and 500 ms 
     const double steps = (end.sim.step_length_multiplier - start.sim.step_length_multiplier) / 0.0195;
     // A step is 1 % of the range (0.0195), shown and kept to the slider's 3 decimals.
     CHECK(steps == Approx(2.0).margin(0.1));  // exactly two steps, not three
-    // Held 1.2 s on an active slider: the press and the repeats due at 0.5, 0.6 … 1.1 s.
+    // Held 1.175 s (141 ticks after the press edge's, 3 a frame) on an active
+    // slider: the press and the repeats due at 0.5, 0.6 … 1.1 s.
     tap(Button::dpad_up);
     tap(Button::south);
     const float before_hold = tuning.working().sim.step_length_multiplier;
     frame(button_bit(Button::dpad_right), 1);
-    for (int i = 0; i < 143; ++i) frame(button_bit(Button::dpad_right), 1);
+    for (int i = 0; i < 47; ++i) frame(button_bit(Button::dpad_right), 3);
     for (int i = 0; i < 4; ++i) frame(0, 1);
     const double held_steps = (tuning.working().sim.step_length_multiplier - before_hold) / 0.0195;
     CHECK(held_steps == Approx(1.0 + 7.0).margin(0.1));
