@@ -79,7 +79,7 @@ void SimulationLoop::run_tick(std::int64_t tick_time_ns, std::int64_t now_ns) {
         if (now_ns - oldest->timestamp_ns > latency_window_max_ns_) latency_window_max_ns_ = now_ns - oldest->timestamp_ns;
     const TickInput pad = assembler_.assemble(shared_.input_ring, tick_time_ns, now_ns, latency_);
     if (const std::uint32_t event = ui::press_event(previous_buttons_, pad.buttons); event != 0)
-        (void)shared_.pad_events.try_push(event);  // full: nobody is reading (no display), drop it
+        (void)shared_.pad_events.try_push(ui::PadPress{event, k + 1});  // full: nobody is reading (no display), drop it
     previous_buttons_ = pad.buttons;
     // The tuning UI is open: the pad drives it, the puppet gets (and the log records) rest.
     const TickInput input = shared_.ui_captures_input.load(std::memory_order_relaxed) ? TickInput{} : pad;
@@ -380,14 +380,14 @@ void feed_tuning_ui(ui::TuningUi* tuning, PipelineShared& sh, const StateFrame& 
     // in the next, so a d-pad move and the south press after it stay in order
     // however slow the frames are.
     // While closed only the chord matters: the queue is drained up to it.
-    std::uint32_t event = 0;
+    ui::PadPress event{};
     if (!tuning->is_open()) {
-        for (std::uint32_t e = 0; event == 0 && sh.pad_events.try_pop(e);)
-            if (e & ui::kChordMade) event = e;
+        for (ui::PadPress e{}; event.event == 0 && sh.pad_events.try_pop(e);)
+            if (e.event & ui::kChordMade) event = e;
     } else if (!tuning->releasing()) {
         (void)sh.pad_events.try_pop(event);
     }
-    tuning->feed_pad(pair.pad, event, sh.pad_events.peek() == nullptr);
+    tuning->feed_pad(pair.pad, pair.current.tick, pair.tick_ns, event, sh.pad_events.peek() == nullptr);
     sh.ui_captures_input.store(tuning->is_open(), std::memory_order_relaxed);
 }
 

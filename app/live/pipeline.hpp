@@ -134,7 +134,7 @@ struct PipelineShared {
     // edits go to the writer, and every configuration the writer hands over
     // comes back to it, so a file edit and a panel edit never undo each other.
     std::atomic<bool> ui_captures_input{false};
-    ui::PadEventRing pad_events;       // presses, in order (ui::press_event)
+    ui::PadEventRing pad_events;       // presses with their ticks, in order (ui::press_event)
     LatestValue<UiEdit> ui_edits;
     LatestValue<SimConfig> accepted_configs;
     // Virtual time only: the newest timestamp the input thread has pushed.

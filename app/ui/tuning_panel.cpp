@@ -117,6 +117,7 @@ void TuningUi::draw_panel(float width, float height) {
     ImGui::PushItemWidth(std::max(110.0f, panel * 0.42f));
     std::string table;
     bool open = false;
+    bool first_drawn = false;
     for (std::size_t i = 0; i < keys_.size(); ++i) {
         const std::string section = keys_[i].table == "locomotion" ? "input" : keys_[i].table;
         if (section != table) {
@@ -124,7 +125,9 @@ void TuningUi::draw_panel(float width, float height) {
             open = ImGui::CollapsingHeader(section_title(keys_[i].table), ImGuiTreeNodeFlags_DefaultOpen);
         }
         if (open) draw_row(i);
+        first_drawn = first_drawn || (open && i == first_editable_);
     }
+    if (!first_drawn) focus_first_ = false;  // its section is collapsed: ImGui's own choice stands
     ImGui::PopItemWidth();
     ImGui::TextDisabled("[gait.walk], [gait.run] prototypes: edit the TOML (no spline editor yet)");
     ImGui::End();

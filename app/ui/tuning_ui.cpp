@@ -98,20 +98,27 @@ void TuningUi::say(const std::string& line, bool problem) {
 void TuningUi::set_open(bool open) {
     if (open == open_) return;
     open_ = open;
+    stepper_ = PadStepper{};  // a d-pad held across the chord does not repeat into the panel
+    steps_ = 0;
     focus_first_ = open;
     focus_frames_ = 0;
     std::fprintf(options_.out, "ui: %s\n", open ? "opened (the pad drives the panel; the puppet idles)" : "closed");
     std::fflush(options_.out);
 }
 
-void TuningUi::feed_pad(const TickInput& held, std::uint32_t press, bool caught_up) {
+void TuningUi::feed_pad(const TickInput& held, std::uint64_t held_tick, std::int64_t tick_ns, PadPress press,
+                        bool caught_up) {
     pad_ = held;
-    caught_up_ = caught_up;
-    press_ = press;
-    if (press & kChordMade) {
+    press_ = press.event;
+    if (press.event & kChordMade) {
         press_ = 0;  // the chord is ours: ImGui does not see back and start
         set_open(!open_);
+        return;
     }
+    // While the first focus settles (releasing()) no step is shown: ImGui would
+    // move the focus back to the first slider after it (seen with 1-5 frames/s).
+    steps_ = open_ && !focus_first_ ? stepper_.frame(press, held.buttons, held_tick, tick_ns, caught_up) : 0;
+    if (focus_first_) press_ = 0;
 }
 
 void TuningUi::adopt(const SimConfig& accepted) { working_.sim = accepted; }
@@ -219,13 +226,15 @@ bool TuningUi::on_native_event(const void* native) {
     }
 }
 
-// The pad into ImGui's navigation inputs: a button counts as down when it is
-// held in the newest tick or went down since the last frame (a press between
-// two slow frames is not lost).
+// The pad into ImGui's navigation inputs. The d-pad, south and east are steps
+// (PadStepper): down in one frame, up in the next, so ImGui sees each as a fresh
+// press (one step) and never runs its own repeat, which it times by summing
+// frame times (a stalled frame would turn a tap into a repeat). The fine/coarse
+// modifiers and the stick are held values.
 void TuningUi::feed_navigation() {
     ImGuiIO& io = ImGui::GetIO();
-    const std::uint32_t held = caught_up_ ? pad_.buttons : 0;
-    auto down = [&](Button b) { return ((held | press_) & button_bit(b)) != 0 ? 1.0f : 0.0f; };
+    auto down = [&](Button b) { return (steps_ & button_bit(b)) != 0 ? 1.0f : 0.0f; };
+    auto held = [&](Button b) { return (pad_.buttons & button_bit(b)) != 0 ? 1.0f : 0.0f; };
     io.NavInputs[ImGuiNavInput_Activate] = down(Button::south);
     io.NavInputs[ImGuiNavInput_Cancel] = down(Button::east);
     io.NavInputs[ImGuiNavInput_DpadUp] = down(Button::dpad_up);
@@ -233,9 +242,9 @@ void TuningUi::feed_navigation() {
     io.NavInputs[ImGuiNavInput_DpadLeft] = down(Button::dpad_left);
     io.NavInputs[ImGuiNavInput_DpadRight] = down(Button::dpad_right);
     io.NavInputs[ImGuiNavInput_TweakSlow] =
-        std::max(down(Button::left_shoulder), static_cast<float>(pad_.left_trigger) / kTriggerScale);
+        std::max(held(Button::left_shoulder), static_cast<float>(pad_.left_trigger) / kTriggerScale);
     io.NavInputs[ImGuiNavInput_TweakFast] =
-        std::max(down(Button::right_shoulder), static_cast<float>(pad_.right_trigger) / kTriggerScale);
+        std::max(held(Button::right_shoulder), static_cast<float>(pad_.right_trigger) / kTriggerScale);
     const float lx = static_cast<float>(pad_.left_x) / kStickScale;
     const float ly = static_cast<float>(pad_.left_y) / kStickScale;
     io.NavInputs[ImGuiNavInput_LStickLeft] = std::max(0.0f, -lx);
@@ -245,8 +254,6 @@ void TuningUi::feed_navigation() {
     // North saves (our shortcut; ImGui's own use of it, text input, is not needed here).
     if (press_ & button_bit(Button::north)) save(std::string(path_buffer_.data()));
 }
-
-constexpr float kMaxUiFrameS = 1.0f / 30.0f;  // s: the longest frame ImGui is told of
 
 void TuningUi::draw(std::int32_t width, std::int32_t height, float dt_s) {
     if (!open_) return;
@@ -262,10 +269,9 @@ void TuningUi::draw(std::int32_t width, std::int32_t height, float dt_s) {
     }
     io.DisplaySize = ImVec2(static_cast<float>(width), static_cast<float>(height));
     io.DisplayFramebufferScale = ImVec2(1.0f, 1.0f);
-    // ImGui times a held d-pad's repeat by summing frame times while it is down.
-    // A stalled frame (llvmpipe under load: 100+ ms) would count as a long hold
-    // and turn one tap into a repeat, so a frame counts as at most 1/30 s.
-    io.DeltaTime = std::clamp(dt_s, 1e-4f, kMaxUiFrameS);
+    // The real frame time (ImGui needs it positive). Pad navigation does not
+    // depend on it: steps are press edges (feed_navigation).
+    io.DeltaTime = std::max(dt_s, 1e-4f);
     feed_navigation();
     ImGui::NewFrame();
     draw_panel(static_cast<float>(width), static_cast<float>(height));

@@ -66,12 +66,17 @@ public:
     TuningUi& operator=(const TuningUi&) = delete;
 
     // Before each frame: the newest tick's buttons and sticks (as the pad held
-    // them, before the UI took them from the puppet), one press event
-    // (ui::press_event; 0: none) and whether the press queue is now empty: the
-    // held buttons count only then, so a queued press is never overtaken.
-    void feed_pad(const TickInput& held, std::uint32_t press, bool caught_up);
-    // The last frame showed a press: this one shows it released (take no event).
-    bool releasing() const { return press_ != 0; }
+    // them, before the UI took them from the puppet), that tick's number and a
+    // tick's length, one press event (ui::press_event and its tick; event 0:
+    // none) and whether the press queue is now empty (held d-pad buttons repeat
+    // only then, so a queued press is never overtaken). Each press is one step
+    // (ui::PadStepper), however long or short the frames are.
+    void feed_pad(const TickInput& held, std::uint64_t held_tick, std::int64_t tick_ns, PadPress press,
+                  bool caught_up);
+    // This frame takes no press event: the last frame showed a step and this one
+    // shows it released, or the panel, just opened, is still putting the focus on
+    // its first slider (a step taken then would be undone by it).
+    bool releasing() const { return stepper_.releasing() || focus_first_; }
     bool is_open() const { return open_; }
     void set_open(bool open);
     // A configuration the writer thread has accepted (a file edit, or ours).
@@ -116,7 +121,8 @@ private:
     std::unique_ptr<render::ImGuiGles3Renderer> renderer_;
     TickInput pad_{};
     std::uint32_t press_ = 0;     // this frame's press event
-    bool caught_up_ = true;
+    PadStepper stepper_;
+    std::uint32_t steps_ = 0;     // the step buttons ImGui sees down this frame
     std::string save_path_;
     std::array<char, 512> path_buffer_{};
     std::string message_;

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include "app/config/config.hpp"
 #include "app/config/program_source.hpp"
@@ -281,7 +282,7 @@ TEST_CASE("golden image: the tuning UI open over the puppet", "[render][golden][
     ui::TuningUiOptions options{default_config(), "", "", stderr};
     ui::TuningUi tuning(view.platform(), options);
     view.set_layer(&tuning);
-    tuning.feed_pad(TickInput{}, 0, true);
+    tuning.feed_pad(TickInput{}, 0, 0, ui::PadPress{}, true);
     tuning.set_open(true);
     render::DebugOverlay overlay{};
     render::feet_overlay_from_state(r.states[0], r.terrain, r.ankle_height, overlay);
@@ -296,13 +297,15 @@ TEST_CASE("the pad chord opens and closes the tuning UI, the d-pad and south mov
     ui::TuningUi tuning(view.platform(), ui::TuningUiOptions{default_config(), "", "", stderr});
     view.set_layer(&tuning);
     std::uint32_t held = 0;
+    std::uint64_t tick = 0;
     // One frame per tick of pad input, as the render thread would see them.
     auto frame_with = [&](std::uint32_t buttons) {
         const std::uint32_t event = ui::press_event(held, buttons);
         held = buttons;
         TickInput pad;
         pad.buttons = buttons;
-        tuning.feed_pad(pad, event, true);
+        ++tick;
+        tuning.feed_pad(pad, tick, 8'333'333, ui::PadPress{event, tick}, true);
         view.frame(r.states[0], render::DebugOverlay{}, "", 1.0f / 60.0f);
     };
     auto press = [&](Button b) {
@@ -335,6 +338,70 @@ TEST_CASE("the pad chord opens and closes the tuning UI, the d-pad and south mov
     CHECK_FALSE(tuning.take_edit(handed));  // once per edit
     frame_with(ui::kUiChord);
     CHECK_FALSE(tuning.is_open());
+}
+
+TEST_CASE("the tuning UI takes each pad press as one step, with 0 ms and 500 ms frames", "[render][ui]") {
+    const Replayed r = replay_ticks("stand_still", {10});
+    render::View view(ui_platform(), render::RenderSettings{}, r.skeleton, r.terrain);
+    ui::TuningUi tuning(view.platform(), ui::TuningUiOptions{default_config(), "", "", stderr});
+    view.set_layer(&tuning);
+    constexpr std::int64_t tick_ns = 8'333'333;  // 120 Hz
+    std::uint64_t tick = 0;
+    std::uint32_t held = 0;
+    std::vector<ui::PadPress> queue;  // as app/live/pipeline.cpp's ring: presses in tick order
+    int frame_count = 0;
+    // A frame after `ticks` new ticks of `buttons`, alternately 0 ms and 500 ms
+    // long in ImGui's time (a stalled llvmpipe frame, then an immediate one).
+    auto frame = [&](std::uint32_t buttons, int ticks) {
+        for (int i = 0; i < ticks; ++i) {
+            ++tick;
+            if (const std::uint32_t e = ui::press_event(held, buttons); e != 0) queue.push_back({e, tick});
+            held = buttons;
+        }
+        ui::PadPress press{};
+        if (!tuning.releasing() && !queue.empty()) {
+            press = queue.front();
+            queue.erase(queue.begin());
+        }
+        TickInput pad;
+        pad.buttons = held;
+        tuning.feed_pad(pad, tick, tick_ns, press, queue.empty());
+        view.frame(r.states[0], render::DebugOverlay{}, "", (frame_count++ % 2 == 0) ? 0.0f : 0.5f);
+    };
+    // A 150 ms tap (18 ticks) seen held over six frames that ImGui is told last 1.5 s in all.
+    auto tap = [&](Button b) {
+        frame(button_bit(b), 3);
+        for (int i = 0; i < 5; ++i) frame(button_bit(b), 3);
+        for (int i = 0; i < 2; ++i) frame(0, 10);
+    };
+    frame(0, 1);
+    frame(ui::kUiChord, 1);
+    REQUIRE(tuning.is_open());
+    // The first tap comes at once: it waits in the queue while the panel puts the
+    // focus on its first slider (a step taken then would be undone).
+    const AppConfig start = tuning.working();
+    tap(Button::dpad_down);   // pelvis_height -> step_length_multiplier
+    tap(Button::south);       // adjust
+    tap(Button::dpad_right);  // +1 %
+    tap(Button::dpad_right);  // +1 %
+    tap(Button::south);       // done
+    tap(Button::dpad_down);   // the next row: nothing changes
+    const AppConfig& end = tuning.working();
+    INFO("message: " << tuning.message());
+    CHECK(end.sim.pelvis_height == start.sim.pelvis_height);
+    const double steps = (end.sim.step_length_multiplier - start.sim.step_length_multiplier) / 0.0195;
+    // A step is 1 % of the range (0.0195), shown and kept to the slider's 3 decimals.
+    CHECK(steps == Approx(2.0).margin(0.1));  // exactly two steps, not three
+    // Held 1.175 s (141 ticks after the press edge's, 3 a frame) on an active
+    // slider: the press and the repeats due at 0.5, 0.6 … 1.1 s.
+    tap(Button::dpad_up);
+    tap(Button::south);
+    const float before_hold = tuning.working().sim.step_length_multiplier;
+    frame(button_bit(Button::dpad_right), 1);
+    for (int i = 0; i < 47; ++i) frame(button_bit(Button::dpad_right), 3);
+    for (int i = 0; i < 4; ++i) frame(0, 1);
+    const double held_steps = (tuning.working().sim.step_length_multiplier - before_hold) / 0.0195;
+    CHECK(held_steps == Approx(1.0 + 7.0).margin(0.1));
 }
 
 TEST_CASE("tuning UI edits pass the schema's checks, save keeps the file's comments and order", "[render][ui]") {
