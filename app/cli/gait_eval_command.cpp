@@ -127,7 +127,7 @@ int gait_eval_command(const GaitEvalOptions& o) {
                    "\"penetration_mm\":{},\"speed_error_pct\":{},\"speed_expectation\":{},\"speed_windows\":{},"
                    "\"max_joint_speed_deg_s\":{},\"fastest_joint\":{},\"fastest_joint_tick\":{},\"obstacle_penetration_mm\":{},\"turn_time_s\":{},\"turns\":{},"
                    "\"steps\":{},\"flight_phases\":{},\"final_hash\":\"{:016x}\",\"limits_ok\":{},"
-                   "\"distance_m\":{},\"distance_ratio_to_gait\":{},\"start_latency_s\":{},\"heading_error_deg\":{},\"pop_ratio\":{}}}\n",
+                   "\"distance_m\":{},\"distance_ratio_to_gait\":{},\"start_latency_s\":{},\"heading_error_deg\":{},\"heading_samples\":{},\"pop_ratio\":{}}}\n",
                    json::quote(config.terrain_name), json::quote(o.program), json::quote(m.motion_source),
                    with_graph ? json::quote(graph_name) : std::string("null"), m.ticks, json::number(m.foot_skate_mm),
                    json::number(m.penetration_mm), json::number(m.speed_error_pct), json::quote(m.speed_expectation),
@@ -135,7 +135,7 @@ int gait_eval_command(const GaitEvalOptions& o) {
                    json::number(m.obstacle_penetration_mm),
                    turn_time_json(m.turn_time_s, !m.turns.empty()), turns_json(m), m.steps, m.flight_phases, m.final_hash,
                    with_graph ? "null" : checked.ok() ? "true" : "false", json::number(m.distance_m),
-                   json::number(m.distance_ratio_to_gait), json::number(m.start_latency_s), json::number(m.heading_error_deg),
+                   json::number(m.distance_ratio_to_gait), json::number(m.start_latency_s), json::number(m.heading_error_deg), m.heading_samples,
                    json::number(m.pop_ratio));
     } else {
         fmt::print("gait-eval: {} on {} ({} ticks, motion from {})\n", o.program, config.terrain_name, m.ticks,
@@ -150,7 +150,8 @@ int gait_eval_command(const GaitEvalOptions& o) {
                    m.fastest_joint, m.fastest_joint_tick);
         fmt::print("  distance_m             {:10.3f}  (ratio to the gait {:.3f})\n", m.distance_m, m.distance_ratio_to_gait);
         fmt::print("  start_latency_s        {:10.3f}  (stick from rest to root speed >= 0.5 m/s, worst; -1: never)\n", m.start_latency_s);
-        fmt::print("  heading_error_deg      {:10.3f}  (mean over the second half of each moving hold)\n", m.heading_error_deg);
+        fmt::print("  heading_error_deg      {:10.3f}  (mean over the second half of each moving hold, {} ticks; -1: no moving hold)\n",
+                   m.heading_error_deg, m.heading_samples);
         fmt::print("  pop_ratio              {:10.3f}  (largest per-tick joint move over its 95th percentile)\n", m.pop_ratio);
         fmt::print("  obstacle_penetration_mm {:9.4f}  (limit < {}; deepest: {} at tick {})\n", m.obstacle_penetration_mm,
                    kMaxObstaclePenetrationMm, m.obstacle_point.empty() ? "none" : m.obstacle_point, m.obstacle_tick);

@@ -168,7 +168,25 @@ std::vector<StickTurn> stick_turns(const StickProgram& program, const SimConfig&
     return turns;
 }
 
+std::vector<HeadingErrorMeter::Hold> heading_holds(const std::vector<Hold>& holds) {
+    std::vector<HeadingErrorMeter::Hold> out;
+    for (const Hold& h : holds) out.push_back({h.first_tick, h.end_tick, h.stick_x, h.stick_y});
+    return out;
+}
+
 }  // namespace
+
+double stick_heading_error_deg(double stick_x, double stick_y, double heading) {
+    return std::fabs(det::wrap_angle(det::atan2(stick_x, -stick_y) - heading)) * det::kRadToDeg;
+}
+
+void HeadingErrorMeter::add(std::uint64_t k, double heading) {
+    for (const Hold& hold : holds_) {
+        if (k < hold.first_tick + (hold.end_tick - hold.first_tick) / 2 || k >= hold.end_tick) continue;
+        sum_ += stick_heading_error_deg(hold.stick_x, hold.stick_y, heading);
+        ++samples_;
+    }
+}
 
 bool foot_in_stance(const PuppetState& s, int foot) {
     // graph_feet: a foot is planted while its pin holds it (not merely while the
@@ -246,7 +264,8 @@ public:
         : config_(config), sim_(sim), terrain_(sim.terrain()), puppet_(puppet), ticks_(ticks), holds_(std::move(holds)),
           turns_(std::move(turns)), turn_index_(turns_.size(), -1), m_(m), previous_(sim.state()), path_(holds_.size(), 0.0),
           expected_(holds_.size(), 0.0), following_(holds_.size(), 0.0),
-          last_sample_(holds_.size()), sample_every_(static_cast<std::uint64_t>(config.tick_rate_hz / 4)) {
+          last_sample_(holds_.size()), sample_every_(static_cast<std::uint64_t>(config.tick_rate_hz / 4)),
+          heading_(heading_holds(holds_)) {
         for (int i = 0; i < 2; ++i)
             stance_anchor_[i] = sim.state().model_positions[static_cast<std::size_t>(puppet.feet[i].ankle)];
         if (feet_csv)
@@ -271,7 +290,8 @@ public:
         m_.start_latency_s = 0.0;
         for (double latency : latencies_) m_.start_latency_s = latency < 0.0 || m_.start_latency_s < 0.0 ? -1.0 : std::max(m_.start_latency_s, latency);
         if (start_tick_ >= 0) m_.start_latency_s = -1.0;  // a start still waiting at the end never got there
-        m_.heading_error_deg = heading_samples_ > 0 ? heading_sum_ / heading_samples_ : 0.0;
+        m_.heading_error_deg = heading_.mean_deg();
+        m_.heading_samples = heading_.samples();
         if (!moves_.empty()) {
             std::vector<double> sorted = moves_;
             std::sort(sorted.begin(), sorted.end());
@@ -405,12 +425,7 @@ private:
             start_tick_ = -1;
         }
         stick_was_pushed_ = pushed;
-        for (const Hold& hold : holds_) {
-            if (k < hold.first_tick + (hold.end_tick - hold.first_tick) / 2 || k >= hold.end_tick) continue;
-            const double want = det::atan2(hold.stick_x, -hold.stick_y);
-            heading_sum_ += std::fabs(det::wrap_angle(want - s.heading)) * det::kRadToDeg;
-            ++heading_samples_;
-        }
+        heading_.add(k, s.heading);
     }
 
     void append_feet_csv_row(int i, const PuppetState& s, const FootPoints& fp, bool stance) {
@@ -505,8 +520,7 @@ private:
     std::vector<double> moves_, latencies_;
     std::int64_t start_tick_ = -1;
     bool stick_was_pushed_ = false;
-    double heading_sum_ = 0.0;
-    std::int64_t heading_samples_ = 0;
+    HeadingErrorMeter heading_;
 };
 
 // The root path length of the gait alone over the same ticks and terrain (the

@@ -41,7 +41,8 @@ struct GaitMetrics {
     double distance_m = 0.0;             // root path length over the program (sampled every quarter second)
     double distance_ratio_to_gait = 1.0; // distance_m over the gait's for the same program and terrain
     double start_latency_s = 0.0;        // worst: stick pushed from rest → root speed ≥ 0.5 m/s (−1: never)
-    double heading_error_deg = 0.0;      // mean |stick direction − heading| over the second half of each moving hold
+    double heading_error_deg = 0.0;      // mean |stick direction − heading| over the second half of each moving hold (−1: no such tick)
+    std::int64_t heading_samples = 0;    // ticks that mean is over (0: the program has no moving hold, e.g. circle)
     double pop_ratio = 0.0;              // largest per-tick joint move over its 95th percentile
     int steps = 0;                       // touchdowns seen in the sole heights
     int flight_phases = 0;               // intervals with both feet off the ground
@@ -81,6 +82,30 @@ Outcome check_gait_metrics_finite(const GaitMetrics& metrics);
 // graph controller's per-frame foot contacts when a motion graph does. The one
 // place that decides where stance comes from.
 bool foot_in_stance(const PuppetState& state, int foot);
+
+// The heading error of one tick: |the stick's direction (atan2(x, −y), the
+// gait's convention) − heading|, wrapped to [0, 180] degrees.
+double stick_heading_error_deg(double stick_x, double stick_y, double heading);
+
+// heading_error_deg over a run: the mean of stick_heading_error_deg over the
+// ticks in the second half of each moving hold [first_tick, end_tick).
+class HeadingErrorMeter {
+public:
+    struct Hold {
+        std::uint64_t first_tick, end_tick;  // end exclusive
+        double stick_x, stick_y;
+    };
+    explicit HeadingErrorMeter(std::vector<Hold> holds) : holds_(std::move(holds)) {}
+    void add(std::uint64_t tick, double heading);
+    // The mean in degrees, −1 when no tick was in a hold's second half.
+    double mean_deg() const { return samples_ > 0 ? sum_ / static_cast<double>(samples_) : -1.0; }
+    std::int64_t samples() const { return samples_; }
+
+private:
+    std::vector<Hold> holds_;
+    double sum_ = 0.0;
+    std::int64_t samples_ = 0;
+};
 
 // `feet_csv`: when not empty, a per-tick CSV of both feet (swing flag, progress,
 // each sole point's height above the ground) is written there, for diagnosis.

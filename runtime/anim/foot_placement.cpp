@@ -17,6 +17,24 @@ vec3 unit_or(vec3 v, vec3 fallback) {
 }
 }  // namespace
 
+void add_foot_tips(FootPlacementRig& rig, std::span<const int> parents, std::span<const int> end_site_parents,
+                   std::span<const vec3> end_site_offsets, float metres_per_unit) {
+    const int count = static_cast<int>(parents.size());
+    for (FootPlacementLeg& leg : rig.legs) {
+        leg.toe = leg.tip_parent = -1;
+        if (leg.ankle < 0) continue;
+        for (int j = 0; j < count && leg.toe < 0; ++j)
+            if (parents[static_cast<size_t>(j)] == leg.ankle) leg.toe = j;
+        const int last = leg.toe >= 0 ? leg.toe : leg.ankle;
+        for (size_t e = 0; e < end_site_parents.size() && e < end_site_offsets.size(); ++e)
+            if (end_site_parents[e] == last) {
+                leg.tip_parent = last;
+                leg.tip = end_site_offsets[e] * metres_per_unit;
+                break;
+            }
+    }
+}
+
 FootPlacementRig make_foot_placement_rig(std::span<const int> parents, int left_ankle, int right_ankle) {
     FootPlacementRig rig;
     const int count = static_cast<int>(parents.size());
@@ -41,13 +59,78 @@ FootPlacementRig make_foot_placement_rig(std::span<const int> parents, int left_
     return rig;
 }
 
+// The two-bone IK of one leg toward `target` (the ankle, world), the foot
+// turned to `foot_world`: the clip's thigh and shin are turned onto the solved
+// bones (shortest arcs), so the skeleton's own segment frames and twist are kept.
+// A degenerate leg (zero length, non-finite target) keeps its pose.
+void FootPlacementJob::solve_leg(const FootPlacementLeg& leg, vec3 target, quat foot_world, vec3 forward) const {
+    const vec3 up(0.0f, 1.0f, 0.0f);
+    const size_t hip = static_cast<size_t>(leg.hip), knee = static_cast<size_t>(leg.knee), ankle = static_cast<size_t>(leg.ankle);
+    const vec3 h = pose.model_positions[hip], k = pose.model_positions[knee], a = pose.model_positions[ankle];
+    TwoBoneIkJob ik;
+    ik.root = h;
+    ik.target = target;
+    ik.pole = unit_or(k - 0.5f * (h + a), forward);
+    ik.upper_length = length_of(pose.local_translations[knee]);
+    ik.lower_length = length_of(pose.local_translations[ankle]);
+    TwoBoneIkResult r;
+    ik.result = &r;
+    if (!ik.run()) return;
+    const quat turn_upper = quat_from_to(unit_or(k - h, -up), unit_or(r.mid - h, -up));
+    const vec3 lower_before = quat_rotate(turn_upper, unit_or(a - k, -up));
+    const quat turn_lower = quat_from_to(lower_before, unit_or(r.end - r.mid, -up));
+    const quat hip_world = quat_normalize(quat_mul(turn_upper, pose.model_rotations[hip]));
+    const quat knee_world = quat_normalize(quat_mul(turn_lower, quat_mul(turn_upper, pose.model_rotations[knee])));
+    const int hip_parent = parents[hip];
+    const quat parent_world = hip_parent >= 0 ? pose.model_rotations[static_cast<size_t>(hip_parent)] : quat_identity();
+    pose.local_rotations[hip] = quat_normalize(quat_mul(quat_conjugate(parent_world), hip_world));
+    pose.local_rotations[knee] = quat_normalize(quat_mul(quat_conjugate(hip_world), knee_world));
+    pose.local_rotations[ankle] = quat_normalize(quat_mul(quat_conjugate(knee_world), foot_world));
+}
+
+// How far (m) the foot's lowest point (ankle, toe, tip) is below the ground under it; ≤ 0: none is.
+float FootPlacementJob::foot_depth(const FootPlacementLeg& leg) const {
+    vec3 points[3];
+    int count = 0;
+    points[count++] = pose.model_positions[static_cast<size_t>(leg.ankle)];
+    if (leg.toe >= 0) points[count++] = pose.model_positions[static_cast<size_t>(leg.toe)];
+    if (leg.tip_parent >= 0) {
+        const size_t p = static_cast<size_t>(leg.tip_parent);
+        points[count++] = pose.model_positions[p] + quat_rotate(pose.model_rotations[p], leg.tip);
+    }
+    float depth = -1e30f;
+    for (int i = 0; i < count; ++i) {
+        const float d = query_ground(*terrain, points[i].x, points[i].z).height - points[i].y;
+        depth = d > depth ? d : depth;
+    }
+    return depth;
+}
+
+// keep_above_ground: each foot below the ground is lifted by its depth (its
+// rotation kept, so every point rises as much). True when a leg moved (the
+// caller runs forward kinematics again).
+bool FootPlacementJob::lift_feet_above_ground(vec3 forward) const {
+    bool moved = false;
+    for (const FootPlacementLeg& leg : rig->legs) {
+        const float depth = foot_depth(leg);
+        if (!(depth > 0.0f)) continue;
+        const size_t ankle = static_cast<size_t>(leg.ankle);
+        solve_leg(leg, pose.model_positions[ankle] + vec3(0.0f, depth, 0.0f), pose.model_rotations[ankle], forward);
+        moved = true;
+    }
+    return moved;
+}
+
 bool FootPlacementJob::validate() const {
     const size_t n = parents.size();
     if (!state || !rig || !terrain || !rig->valid || !(dt >= 0.0f) || !(release_s >= 0.0f) || !(terrain_rate > 0.0f)) return false;
     if (!pose.has_joints(n) || !parents_in_topological_order(parents)) return false;
     const auto is_joint = [n](std::int32_t j) { return j >= 0 && static_cast<size_t>(j) < n; };
+    const auto none_or_joint = [&](std::int32_t j) { return j == -1 || is_joint(j); };
     for (const FootPlacementLeg& leg : rig->legs)
-        if (!is_joint(leg.hip) || !is_joint(leg.knee) || !is_joint(leg.ankle)) return false;
+        if (!is_joint(leg.hip) || !is_joint(leg.knee) || !is_joint(leg.ankle) || !none_or_joint(leg.toe) ||
+            !none_or_joint(leg.tip_parent))
+            return false;
     return is_joint(rig->root);
 }
 
@@ -93,8 +176,7 @@ bool FootPlacementJob::run() const {
     for (int i = 0; i < 2; ++i) {
         const FootPlacementLeg& leg = rig->legs[static_cast<size_t>(i)];
         FootPin& pin = s.feet[static_cast<size_t>(i)];
-        const size_t hip = static_cast<size_t>(leg.hip), knee = static_cast<size_t>(leg.knee),
-                     ankle = static_cast<size_t>(leg.ankle);
+        const size_t ankle = static_cast<size_t>(leg.ankle);
         // The clip's ankle, as high above the ground under it as it was above its flat floor.
         const vec3 free = pose.model_positions[ankle] + vec3(0.0f, pin.ground - s.body_offset, 0.0f);
         const bool contact = ((contacts >> i) & 1u) && slow[i];
@@ -123,37 +205,18 @@ bool FootPlacementJob::run() const {
                                : clamp01(pin.plant + (pin.contact == 1 ? plant_step : -plant_step));
         const vec3 target = lerp(pin.pin, free, smoothstep(pin.release));
 
-        const vec3 h = pose.model_positions[hip], k = pose.model_positions[knee], a = pose.model_positions[ankle];
-        TwoBoneIkJob ik;
-        ik.root = h;
-        ik.target = target;
-        ik.pole = unit_or(k - 0.5f * (h + a), forward);
-        ik.upper_length = length_of(pose.local_translations[knee]);
-        ik.lower_length = length_of(pose.local_translations[ankle]);
-        TwoBoneIkResult r;
-        ik.result = &r;
-        if (!ik.run()) continue;  // a degenerate leg (zero length, non-finite target) keeps the clip's pose
-        // Turn the clip's thigh and shin onto the solved bones (shortest arcs), so
-        // the skeleton's own segment frames and twist are kept.
-        const quat turn_upper = quat_from_to(unit_or(k - h, -up), unit_or(r.mid - h, -up));
-        const vec3 lower_before = quat_rotate(turn_upper, unit_or(a - k, -up));
-        const quat turn_lower = quat_from_to(lower_before, unit_or(r.end - r.mid, -up));
-        const quat hip_world = quat_normalize(quat_mul(turn_upper, pose.model_rotations[hip]));
-        const quat knee_world = quat_normalize(quat_mul(turn_lower, quat_mul(turn_upper, pose.model_rotations[knee])));
         // A planted foot lies on the ground's slope; a lifted one keeps the clip's.
         // (The normal under the target, not under the clip's foot: a pinned foot
         // must not tilt because the clip's foot slid over a slope's edge.)
         const vec3 normal = query_ground(*terrain, target.x, target.z).normal;
         const quat tilt = quat_slerp(quat_identity(), quat_from_to(up, normal), smoothstep(pin.plant));
-        const quat foot_world = quat_normalize(quat_mul(tilt, pose.model_rotations[ankle]));
-        const int hip_parent = parents[hip];
-        const quat parent_world = hip_parent >= 0 ? pose.model_rotations[static_cast<size_t>(hip_parent)] : quat_identity();
-        pose.local_rotations[hip] = quat_normalize(quat_mul(quat_conjugate(parent_world), hip_world));
-        pose.local_rotations[knee] = quat_normalize(quat_mul(quat_conjugate(hip_world), knee_world));
-        pose.local_rotations[ankle] = quat_normalize(quat_mul(quat_conjugate(knee_world), foot_world));
+        solve_leg(leg, target, quat_normalize(quat_mul(tilt, pose.model_rotations[ankle])), forward);
     }
     // Cannot fail: validate() checked the sizes and the order FK needs.
     if (!LocalToModelJob{parents, pose.local(), pose.model()}.run()) return false;
+    if (keep_above_ground && lift_feet_above_ground(forward) &&
+        !LocalToModelJob{parents, pose.local(), pose.model()}.run())
+        return false;
     for (int i = 0; i < 2; ++i)
         s.feet[static_cast<size_t>(i)].placed = pose.model_positions[static_cast<size_t>(rig->legs[static_cast<size_t>(i)].ankle)];
     s.started = 1;

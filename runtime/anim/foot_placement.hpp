@@ -45,6 +45,11 @@ struct FootPlacementState {
 
 struct FootPlacementLeg {
     std::int32_t hip = -1, knee = -1, ankle = -1;
+    // The foot's lower points beyond the ankle, for keep_above_ground
+    // (add_foot_tips): the toe joint (the ankle's first child) and the end site
+    // past the toe (an offset in metres in tip_parent's frame); −1: none.
+    std::int32_t toe = -1, tip_parent = -1;
+    vec3 tip{0.0f};
 };
 
 struct FootPlacementRig {
@@ -56,6 +61,12 @@ struct FootPlacementRig {
 // The legs of a skeleton from its foot (ankle) joints; invalid when a foot is
 // missing or has fewer than two ancestors below the root.
 FootPlacementRig make_foot_placement_rig(std::span<const int> parents, int left_ankle, int right_ankle);
+
+// Fills each leg's toe joint (the ankle's first child) and the end site past
+// the toe (or past the ankle without a toe), its offset scaled to metres. The
+// skeleton's end sites: parents and offsets, parallel.
+void add_foot_tips(FootPlacementRig& rig, std::span<const int> parents, std::span<const int> end_site_parents,
+                   std::span<const vec3> end_site_offsets, float metres_per_unit);
 
 // A pin that drifts this far (horizontally) from the clip's foot is let go, so a
 // long blend cannot stretch the leg out of reach.
@@ -80,11 +91,21 @@ struct FootPlacementJob {
     std::span<const int> parents;
     // In: the clip pose (locals) and its forward kinematics. Out: the placed pose, both.
     PoseSpans pose;
+    // After placement, a foot whose ankle, toe or tip (add_foot_tips) is below
+    // the ground under it is lifted (two-bone IK again, the foot's rotation kept)
+    // until its lowest point is on the ground: no point of the foot penetrates.
+    bool keep_above_ground = false;
 
-    // False without a state, rig or terrain, with an invalid rig, a negative time
+    // False without a state, rig or terrain, with an invalid rig (a toe or tip
+    // joint neither −1 nor a joint included), a negative time
     // or rate, spans not of the skeleton's size, or parents out of order.
     bool validate() const;
     [[nodiscard]] bool run() const;
+
+private:
+    void solve_leg(const FootPlacementLeg& leg, vec3 target, quat foot_world, vec3 forward) const;
+    float foot_depth(const FootPlacementLeg& leg) const;
+    bool lift_feet_above_ground(vec3 forward) const;
 };
 
 }  // namespace marionette

@@ -194,8 +194,10 @@ void Simulation::use_motion_graph(std::shared_ptr<const MotionGraph> graph, cons
     if (graph->joint_count() > kMaxJoints) throw std::invalid_argument("motion graph skeleton has too many joints");
     if (!(metres_per_unit > 0.0)) throw std::invalid_argument("metres_per_unit must be positive");
     auto controller = std::make_unique<GraphController>(*graph, config);  // validates the graph
-    const FootPlacementRig foot_rig =
+    FootPlacementRig foot_rig =
         make_foot_placement_rig(std::span<const int>(graph->skeleton.parents), graph->left_foot, graph->right_foot);
+    add_foot_tips(foot_rig, graph->skeleton.parents, graph->skeleton.end_site_parents, graph->skeleton.end_site_offsets,
+                  static_cast<float>(metres_per_unit));
     const std::int32_t source = resolve_motion_source(config_, true);
     if (source == kSourceGraphFeet && !foot_rig.valid)
         throw std::invalid_argument("motion.source graph_feet: the motion graph names no foot joints with a knee and a hip");
@@ -220,7 +222,7 @@ void Simulation::use_motion_graph(std::shared_ptr<const MotionGraph> graph, cons
         state_.matching = matching_->initial_state(vec3(0.0f), 0.0f);
         state_.matching_active = 1;
         step_matching(TickInput{}, 0.0f, matching_pose_);
-        place_feet(matching_pose_, 0.0f, matching_feet_pose_, state_.matching_feet, state_.matching.contacts);
+        place_feet(matching_pose_, 0.0f, matching_feet_pose_, state_.matching_feet, state_.matching.contacts, true);
         output(matching_feet_pose_, source, 0.0f);
         return;
     }
@@ -248,7 +250,8 @@ void Simulation::step_graph(const TickInput& input, float dt, Pose& out) {
     expect_job_ran(LocalToModelJob{std::span<const int>(graph_->skeleton.parents), pose.local(), pose.model()}.run());
 }
 
-void Simulation::place_feet(const Pose& clip, float dt, Pose& out, FootPlacementState& feet, std::uint8_t contacts) {
+void Simulation::place_feet(const Pose& clip, float dt, Pose& out, FootPlacementState& feet, std::uint8_t contacts,
+                            bool keep_above_ground) {
     out = clip;
     const size_t n = static_cast<size_t>(graph_->joint_count());
     const FootPlacementJob job{&feet,
@@ -259,7 +262,8 @@ void Simulation::place_feet(const Pose& clip, float dt, Pose& out, FootPlacement
                                config_.feet_release_s,
                                config_.feet_terrain_rate,
                                std::span<const int>(graph_->skeleton.parents),
-                               out.spans(n)};
+                               out.spans(n),
+                               keep_above_ground};
     expect_job_ran(job.run());
 }
 
@@ -427,7 +431,7 @@ void Simulation::step(const TickInput& input) {
     if (uses(kSourceGraphFeet, kSourceGraphFeet)) place_feet(graph_pose_, dt, feet_pose_, s.feet, s.graph.contacts);
     if (uses(kSourceMatching, kSourceMatching)) {
         step_matching(input, dt, matching_pose_);
-        place_feet(matching_pose_, dt, matching_feet_pose_, s.matching_feet, s.matching.contacts);
+        place_feet(matching_pose_, dt, matching_feet_pose_, s.matching_feet, s.matching.contacts, true);
     }
     auto pose_of = [&](std::int32_t source) -> const Pose& {
         switch (source) {

@@ -138,7 +138,9 @@ private:
     void step_gait(const TickInput& input, float dt, Pose& out);
     void pose_gait(Pose& out) const;
     void step_graph(const TickInput& input, float dt, Pose& out);
-    void place_feet(const Pose& clip, float dt, Pose& out, FootPlacementState& feet, std::uint8_t contacts);
+    // keep_above_ground: matching's feet (FootPlacementJob::keep_above_ground); graph_feet's are placed as before.
+    void place_feet(const Pose& clip, float dt, Pose& out, FootPlacementState& feet, std::uint8_t contacts,
+                    bool keep_above_ground = false);
     void step_matching(const TickInput& input, float dt, Pose& out);
     void attach_matching();
     void begin_source_change(std::int32_t source);

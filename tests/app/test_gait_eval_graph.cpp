@@ -61,3 +61,66 @@ TEST_CASE("gait-eval: a walk on the default motion graph gives finite metrics fr
     CHECK(gait.motion_source == "gait");
     CHECK(gait.final_hash != m.final_hash);
 }
+
+TEST_CASE("gait-eval: heading error of one tick, in the gait's stick convention and wrapped", "[gait_eval]") {
+    // atan2(x, −y): stick up (y = −1) is heading 0, stick right (x = 1) is +90°.
+    CHECK(stick_heading_error_deg(0.0, -1.0, 0.0) == Approx(0.0).margin(1e-9));
+    CHECK(stick_heading_error_deg(1.0, 0.0, 0.0) == Approx(90.0).margin(1e-6));
+    CHECK(stick_heading_error_deg(1.0, 0.0, 1.5707963267948966) == Approx(0.0).margin(1e-6));
+    CHECK(stick_heading_error_deg(0.0, 1.0, 0.0) == Approx(180.0).margin(1e-6));
+    // Across ±180°: stick at 179°, heading at −179° is 2° off, not 358°.
+    const double deg = 3.14159265358979 / 180.0;
+    CHECK(stick_heading_error_deg(std::sin(179.0 * deg), -std::cos(179.0 * deg), -179.0 * deg) == Approx(2.0).margin(1e-6));
+    // Generated (fixed seed): every direction and offset in (−180, 180) reads back as |offset|.
+    std::uint32_t seed = 12345u;
+    auto next = [&] { seed = seed * 1664525u + 1013904223u; return static_cast<double>(seed >> 8) / 16777216.0; };
+    for (int i = 0; i < 500; ++i) {
+        const double direction = (next() * 2.0 - 1.0) * 180.0 * deg;
+        const double offset = (next() * 2.0 - 1.0) * 179.0;
+        const double heading = direction - offset * deg;
+        CHECK(stick_heading_error_deg(std::sin(direction), -std::cos(direction), heading) == Approx(std::fabs(offset)).margin(1e-6));
+    }
+}
+
+TEST_CASE("gait-eval: heading error is the mean over the second half of each moving hold", "[gait_eval]") {
+    // Hold 1: ticks 0..99, stick right (+90°); hold 2: ticks 200..239, stick up (0°).
+    HeadingErrorMeter meter({{0, 100, 1.0, 0.0}, {200, 240, 0.0, -1.0}});
+    const double deg = 3.14159265358979 / 180.0;
+    for (std::uint64_t k = 0; k < 300; ++k) {
+        double heading = 0.0;                          // first half of hold 1 and between holds: not counted
+        if (k >= 50 && k < 100) heading = 60.0 * deg;  // 30° short of the stick
+        if (k >= 200 && k < 220) heading = 90.0 * deg; // first half of hold 2: not counted
+        if (k >= 220 && k < 240) heading = -10.0 * deg; // 10° off
+        meter.add(k, heading);
+    }
+    CHECK(meter.samples() == 70);
+    CHECK(meter.mean_deg() == Approx((50 * 30.0 + 20 * 10.0) / 70.0).epsilon(1e-9));
+    // No moving hold: no samples, and the mean says so (−1), not a perfect 0.
+    HeadingErrorMeter none({});
+    none.add(0, 1.0);
+    CHECK(none.samples() == 0);
+    CHECK(none.mean_deg() == -1.0);
+}
+
+TEST_CASE("gait-eval: the heading error is measured on a real run, and is not 0 when the puppet faces away", "[gait_eval]") {
+    const AppConfig shipped = default_config();
+    const StickProgram program = load_program("builtin:fast_walk");
+    const GaitMetrics gait = evaluate_gait(shipped.sim, program);
+    CHECK(gait.heading_samples > 0);
+    CHECK(gait.heading_error_deg >= 0.0);
+    CHECK(gait.heading_error_deg < 10.0);
+    // A known non-zero error: the heading may turn at only 10°/s. 3 s up
+    // (heading 0: no turn), then 3 s right (+90°): the measured half of the second
+    // hold runs from 2.25 s to 3 s into it, when the heading has turned about
+    // 22.5°…30° (the turn starts as the stick moves), so it reads about 90 − 26 = 64°
+    // there and the mean over both holds' measured halves about 32°.
+    SimConfig slow = shipped.sim;
+    slow.turn_rate_deg_s = 10.0f;
+    const StickProgram turn = parse_stick_program("ramp 100ms ly=-1\nhold 3s\nramp 100ms lx=1 ly=0\nhold 3s\n", "turn.prog");
+    const GaitMetrics turned = evaluate_gait(slow, turn);
+    CHECK(turned.heading_samples > 0);
+    CHECK(turned.heading_error_deg > 25.0);
+    CHECK(turned.heading_error_deg < 40.0);
+    const GaitMetrics free_turn = evaluate_gait(shipped.sim, turn);  // 360°/s: faces the stick long before
+    CHECK(free_turn.heading_error_deg < 2.0);
+}

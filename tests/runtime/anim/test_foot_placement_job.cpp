@@ -173,3 +173,65 @@ TEST_CASE("FootPlacementJob::run never allocates", "[foot_placement][job]") {
     CHECK(test::allocation_count() == before);
     CHECK(refused == 0);
 }
+
+namespace {
+// The lowest point of each foot (ankle, or its tip) minus the ground under it.
+float foot_clearance(const FootPlacementRig& rig, const ClipPose& pose, const Terrain& ground, int foot) {
+    const FootPlacementLeg& leg = rig.legs[static_cast<size_t>(foot)];
+    const vec3 a = pose.model_positions[static_cast<size_t>(leg.ankle)];
+    const size_t p = static_cast<size_t>(leg.tip_parent);
+    const vec3 tip = pose.model_positions[p] + quat_rotate(pose.model_rotations[p], leg.tip);
+    const float ca = a.y - query_ground(ground, a.x, a.z).height;
+    const float ct = tip.y - query_ground(ground, tip.x, tip.z).height;
+    return ca < ct ? ca : ct;
+}
+}  // namespace
+
+TEST_CASE("FootPlacementJob: keep_above_ground lifts a foot whose tip is under the ground", "[foot_placement][job]") {
+    FootPlacementRig rig = make_foot_placement_rig(kLegParents, kLeftAnkle, kRightAnkle);
+    const std::vector<int> site_parents = {kLeftAnkle, kRightAnkle};
+    std::uint32_t seed = 777u;
+    auto next = [&] { seed = seed * 1664525u + 1013904223u; return static_cast<float>(seed >> 8) / 16777216.0f; };
+    // Generated cases (fixed seed): tips 0–15 cm below and 0–25 cm ahead of the
+    // ankle (in metres ×2: the scale is applied), ground from −5 to +5 cm.
+    for (int c = 0; c < 200; ++c) {
+        const std::vector<vec3> site_offsets = {vec3(0.0f, -0.075f * next(), 0.125f * next()),
+                                                vec3(0.0f, -0.075f * next(), 0.125f * next())};
+        add_foot_tips(rig, kLegParents, site_parents, site_offsets, 2.0f);
+        REQUIRE(rig.legs[0].tip_parent == kLeftAnkle);
+        REQUIRE(rig.legs[0].toe == -1);  // the ankle has no child joint here
+        const Terrain ground = raised_ground(0.1f * next() - 0.05f);
+        for (const bool keep : {false, true}) {
+            FootPlacementState state;
+            ClipPose pose;
+            const ClipPose clip = pose;
+            FootPlacementJob job{&state, &rig, &ground, kBothFeetInContact, 0.0f, 0.15f, 10.0f, kLegParents, pose.spans(), keep};
+            REQUIRE(job.run());
+            // A second tick, advancing.
+            pose = clip;
+            job.pose = pose.spans();
+            job.dt = 1.0f / 240.0f;
+            REQUIRE(job.run());
+            for (int foot = 0; foot < 2; ++foot) {
+                const float clearance = foot_clearance(rig, pose, ground, foot);
+                if (keep) {
+                    CHECK(clearance >= -1e-4f);
+                    // Lifted straight up: the pinned ankle keeps its place on the ground plane, the foot its rotation.
+                    const size_t a = static_cast<size_t>(rig.legs[static_cast<size_t>(foot)].ankle);
+                    CHECK(pose.model_positions[a].x == Approx(clip.model_positions[a].x).margin(1e-4));
+                    CHECK(pose.model_positions[a].z == Approx(clip.model_positions[a].z).margin(1e-4));
+                    CHECK(quat_angle_between(pose.model_rotations[a], clip.model_rotations[a]) < 1e-3);
+                } else if (c == 0) {
+                    INFO("without keep_above_ground the generated first case's tip is below the ground");
+                    CHECK(clearance < -1e-3f);
+                }
+            }
+        }
+    }
+    // A tip joint that is not a joint is refused.
+    rig.legs[1].tip_parent = 99;
+    FootPlacementState state;
+    ClipPose pose;
+    const Terrain flat;
+    CHECK_FALSE((FootPlacementJob{&state, &rig, &flat, kBothFeetInContact, 0.0f, 0.15f, 10.0f, kLegParents, pose.spans(), true}.validate()));
+}
