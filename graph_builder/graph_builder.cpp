@@ -180,7 +180,7 @@ void copy_clips(const ClipDatabase& db, const std::vector<vec3>& positions, doub
 // once by the closed-form alignment of its windows, in parallel.
 std::vector<PlacedTransition> place_candidates(const ClipDatabase& db, const std::vector<vec3>& positions,
                                                const FrameFeatures& features,
-                                               const std::vector<TransitionCandidate>& candidates, double leg,
+                                               const std::vector<TransitionCandidate>& candidates,
                                                const GraphBuildParams& params) {
     std::vector<PlacedTransition> placed;
     for (const TransitionCandidate& t : candidates) {
@@ -194,8 +194,8 @@ std::vector<PlacedTransition> place_candidates(const ClipDatabase& db, const std
         std::max(1u, params.threads > 0 ? static_cast<unsigned>(params.threads) : std::thread::hardware_concurrency());
     const auto work = [&](unsigned w) {
         for (size_t c = w; c < placed.size(); c += threads)
-            reference_pair_distance(db, positions, params.window_frames, leg, placed[c].candidate.from_frame,
-                                    placed[c].candidate.to_frame, &placed[c].align);
+            placed[c].align = reference_pair_alignment(db, positions, params.window_frames, placed[c].candidate.from_frame,
+                                                       placed[c].candidate.to_frame);
     };
     std::vector<std::thread> workers;  // the calling thread is worker 0
     for (unsigned w = 1; w < threads; ++w) workers.emplace_back(work, w);
@@ -338,7 +338,7 @@ GraphBuildOutput build_motion_graph(const ClipDatabase& db, const GraphBuildPara
     MotionGraph& g = out.graph;
     copy_clips(db, positions, leg, params, g);
     std::vector<PlacedTransition> chosen, bridges;
-    for (const PlacedTransition& t : place_candidates(db, positions, features, out.candidates, leg, params))
+    for (const PlacedTransition& t : place_candidates(db, positions, features, out.candidates, params))
         (t.candidate.distance <= out.threshold ? chosen : bridges).push_back(t);
     out.regular_candidates = static_cast<std::int64_t>(chosen.size());
     BridgePool pool = make_bridge_pool(std::move(bridges), features, g.clips.size());

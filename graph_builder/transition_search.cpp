@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -202,8 +203,8 @@ double feature_pair_distance(const FrameFeatures& f, std::int32_t i, std::int32_
     return distance_from_sums(f, i, g, sd, sc, sy);
 }
 
-double reference_pair_distance(const ClipDatabase& db, std::span<const vec3> positions, int window, double scale,
-                               std::int32_t i, std::int32_t j, PlanarTransform* align) {
+PlanarTransform reference_pair_alignment(const ClipDatabase& db, std::span<const vec3> positions, int window,
+                                         std::int32_t i, std::int32_t j) {
     const size_t J = static_cast<size_t>(db.skeleton.joint_count());
     const std::int32_t g = j - window + 1;
     PlanarCrossSums sums;
@@ -211,7 +212,14 @@ double reference_pair_distance(const ClipDatabase& db, std::span<const vec3> pos
         for (size_t q = 0; q < J; ++q)
             accumulate_planar_sums(sums, positions[static_cast<size_t>(i + t) * J + q],
                                    positions[static_cast<size_t>(g + t) * J + q], db.joint_weights[q]);
-    const PlanarTransform t = align_from_sums(sums);
+    return align_from_sums(sums);
+}
+
+double reference_pair_distance(const ClipDatabase& db, std::span<const vec3> positions, int window, double scale,
+                               std::int32_t i, std::int32_t j, PlanarTransform* align) {
+    const size_t J = static_cast<size_t>(db.skeleton.joint_count());
+    const std::int32_t g = j - window + 1;
+    const PlanarTransform t = reference_pair_alignment(db, positions, window, i, j);
     if (align) *align = t;
     double total = 0.0;
     for (int s = 0; s < window; ++s) {
@@ -379,8 +387,12 @@ MARIONETTE_VECTOR_CLONES void window_distances(const double* __restrict sums, st
         const double d = a.spread + col_spread[c] - 2.0 * sums[2 * n + c] - 2.0 * std::sqrt(dot * dot + cross * cross);
         const double v = d * inv_wk;
         const double lo = v - bound, hi = v + bound;
-        lo_out[c] = static_cast<float>(lo > kDistanceNoiseFloor ? lo : 0.0);
-        hi_out[c] = static_cast<float>(hi > kDistanceNoiseFloor ? hi : 0.0);
+        // (x > floor ? x : +0) as a bit mask, without a branch, so the loop vectorises (the
+        // select compiled to a branch and kept it scalar); the same bits as the select.
+        const std::uint64_t keep_lo = -static_cast<std::uint64_t>(lo > kDistanceNoiseFloor);
+        const std::uint64_t keep_hi = -static_cast<std::uint64_t>(hi > kDistanceNoiseFloor);
+        lo_out[c] = static_cast<float>(std::bit_cast<double>(std::bit_cast<std::uint64_t>(lo) & keep_lo));
+        hi_out[c] = static_cast<float>(std::bit_cast<double>(std::bit_cast<std::uint64_t>(hi) & keep_hi));
     }
 }
 
@@ -406,8 +418,9 @@ struct TileScratch {
     std::vector<double> col_spread, col_x, col_z;  // per column's window B
     std::vector<std::int32_t> invalid_cols;
     ScratchArray<float> box_lo, box_hi;   // lower and upper bounds of the distances of a computed box
-    ScratchArray<float> d;                // the lower bounds of a tile read transposed from the box
-    std::vector<std::uint8_t> mask;       // a tile row's cells that may be kept
+    std::vector<std::uint8_t> mask;       // a tile line's cells that may be kept
+    std::vector<std::pair<std::int32_t, std::int32_t>> cells, sorted;  // a tile's cells that may be kept
+    std::vector<size_t> row_start;        // (counting sort of the cells by row)
     std::vector<std::pair<int, int>> undecided;  // neighbours whose order against a cell needs the exact kernel
     std::vector<TransitionCandidate> found;
     std::vector<float> plot;
@@ -435,8 +448,8 @@ void perturb_products(double* c, std::int32_t row0, std::int32_t nr, std::int32_
 struct TileSpan {
     std::int32_t ci0, ci1, cj0, cj1;  // the cells this tile decides
     std::int32_t ei0, ei1, ej0, ej1;  // the cells it holds (plus the halo)
-    const float* lo = nullptr;        // the held cells' lower bounds, (ei0, ej0) first, rows `stride` apart
-    size_t stride = 0;
+    const float* lo = nullptr;        // the held cells' lower bounds, (ei0, ej0) first, i and j steps apart
+    size_t lo_i_step = 0, lo_j_step = 1;  // (tile (b, a) reads the box transposed: i step 1)
     const float* hi = nullptr;        // their upper bounds, (ei0, ej0) first, i and j steps apart
     size_t hi_i_step = 0, hi_j_step = 1;
     bool empty() const { return ci0 >= ci1 || cj0 >= cj1; }
@@ -464,8 +477,14 @@ struct TileView {
                    ? kPairInvalid
                    : t.hi[static_cast<size_t>(i - t.ei0) * t.hi_i_step + static_cast<size_t>(j - t.ej0) * t.hi_j_step];
     }
+    // Cell (i, j)'s upper bound in memory, of a held cell or one beside the held cells' edge
+    // (along a line: the caller reads only held cells).
+    const float* hi_ptr(std::int32_t i, std::int32_t j) const {
+        return t.hi + (static_cast<std::ptrdiff_t>(i - t.ei0) * static_cast<std::ptrdiff_t>(t.hi_i_step) +
+                       static_cast<std::ptrdiff_t>(j - t.ej0) * static_cast<std::ptrdiff_t>(t.hi_j_step));
+    }
     size_t at(std::int32_t i, std::int32_t j) const {
-        return static_cast<size_t>(i - t.ei0) * t.stride + static_cast<size_t>(j - t.ej0);
+        return static_cast<size_t>(i - t.ei0) * t.lo_i_step + static_cast<size_t>(j - t.ej0) * t.lo_j_step;
     }
 };
 
@@ -504,6 +523,95 @@ void decide_cell(const FrameFeatures& f, const CandidateSearchOptions& o, const 
     if (best.size() > static_cast<size_t>(o.bridges_per_clip_pair)) best.pop_back();
 }
 
+// A tile row's valid pairs (counted) and the cells that may be kept (0 ≤ lo ≤ keep_f;
+// absent pairs not), a byte each, in one branch-free loop (`&`, not `&&`: it vectorises).
+MARIONETTE_VECTOR_CLONES std::int64_t mark_keepable(const float* __restrict row, std::int32_t width, float keep_f,
+                                                    std::uint8_t* __restrict mask) {
+    std::int64_t evaluated = 0;
+    for (std::int32_t c = 0; c < width; ++c) {
+        const float v = row[c];
+        evaluated += (v >= 0.0f) & (v < kPairInvalid);
+        mask[c] = static_cast<std::uint8_t>((v >= 0.0f) & (v <= keep_f));
+    }
+    return evaluated;
+}
+
+// The local minima of the tile's cells, decided on the fixed-order kernel's values.
+// The intervals settle most comparisons: a neighbour whose upper bound is below the
+// cell's lower bound is smaller whatever the rounding, one whose lower bound is above
+// the cell's upper bound larger; the cell's own value and those of neighbours whose
+// interval meets it (and is more than one float wide) are computed exactly. So the
+// result is the local-minimum rule on the exact matrix, cell for cell.
+// Clears mask[q] where a direct neighbour (the 3 × 3 ring) of cell q is surely smaller
+// (its upper bound below the cell's lower bound, or excluded: −1): decide_cell's first
+// test, on all of a line's marked cells at once and vectorised. hm, h0, hp: the upper
+// bounds of the lines before, at and after the cell's, [q − 1, q + 1] readable.
+MARIONETTE_VECTOR_CLONES void clear_beaten(const float* __restrict lo, const float* __restrict hm,
+                                           const float* __restrict h0, const float* __restrict hp, std::int32_t n,
+                                           std::uint8_t* __restrict mask) {
+    for (std::int32_t q = 0; q < n; ++q) {
+        const float a = std::min(std::min(hm[q - 1], hm[q]), std::min(hm[q + 1], h0[q - 1]));
+        const float b = std::min(std::min(h0[q + 1], hp[q - 1]), std::min(hp[q], hp[q + 1]));
+        mask[q] = static_cast<std::uint8_t>(mask[q] & static_cast<std::uint8_t>(!(std::min(a, b) < lo[q])));
+    }
+}
+
+// The tile's cells that may be kept (mark_keepable), as (row, column) offsets from
+// (ci0, cj0) in the tile's raster order, into s.cells; counts the valid pairs. The
+// lower bounds are scanned along the box's rows: a tile's rows, or for a tile read
+// transposed (lo_j_step ≠ 1) its columns, whose marked cells a counting sort then
+// puts back into row order (columns ascending within a row, as a row scan gives).
+void collect_keepable(const CandidateSearchOptions& o, const TileSpan& t, float keep_f, std::int32_t N, TileScratch& s) {
+    const TileView m{t};
+    const bool by_rows = t.lo_j_step == 1;
+    const std::int32_t rows = t.ci1 - t.ci0, cols = t.cj1 - t.cj0;
+    const std::int32_t lines = by_rows ? rows : cols, length = by_rows ? cols : rows;
+    s.mask.resize(static_cast<size_t>(length + 8));
+    std::uint8_t* __restrict mask = s.mask.data();
+    s.cells.clear();
+    for (std::int32_t l = 0; l < lines; ++l) {
+        const float* __restrict line = t.lo + (by_rows ? m.at(t.ci0 + l, t.cj0) : m.at(t.ci0, t.cj0 + l));
+        s.evaluations += mark_keepable(line, length, keep_f, mask);
+        // Cells whose 3 × 3 ring lies in the held cells: a surely smaller direct neighbour
+        // rules them out here (decide_cell would at its first test; edge cells go there).
+        const std::int32_t hl = by_rows ? t.ci0 + l : t.cj0 + l;  // the line's i (rows) or j
+        const bool ring_lines = by_rows ? hl > t.ei0 && hl + 1 < t.ei1 : hl > t.ej0 && hl + 1 < t.ej1;
+        if (ring_lines) {
+            const std::int32_t p0 = by_rows ? t.cj0 : t.ci0, e0 = by_rows ? t.ej0 : t.ei0, e1 = by_rows ? t.ej1 : t.ei1;
+            const std::int32_t qa = std::max(0, e0 + 1 - p0), qb = std::min(length, e1 - 1 - p0);
+            const auto hi_line = [&](std::int32_t d) {
+                return by_rows ? m.hi_ptr(hl + d, p0) : m.hi_ptr(p0, hl + d);
+            };
+            if (qa < qb)
+                clear_beaten(line + qa, hi_line(-1) + qa, hi_line(0) + qa, hi_line(1) + qa, qb - qa, mask + qa);
+        }
+        if (o.plot)  // (the picture shows the lower bounds: it is not part of the graph)
+            for (std::int32_t q = 0; q < length; ++q) {
+                const float v = line[q];
+                if (!(v >= 0.0f && v < kPairInvalid)) continue;
+                const std::int64_t i = t.ci0 + (by_rows ? l : q), j = t.cj0 + (by_rows ? q : l);
+                const size_t px = static_cast<size_t>(i * o.plot_size / N), py = static_cast<size_t>(j * o.plot_size / N);
+                float& pixel = s.plot[px * static_cast<size_t>(o.plot_size) + py];
+                pixel = std::min(pixel, v);
+            }
+        for (std::int32_t q = length; q % 8 != 0; ++q) mask[q] = 0;
+        for (std::int32_t word = 0; word < length; word += 8) {  // eight mask bytes at a time
+            std::uint64_t bits;
+            std::memcpy(&bits, mask + word, sizeof bits);
+            if (bits == 0) continue;
+            for (std::int32_t q = word; q < word + 8; ++q)
+                if (mask[q]) s.cells.push_back(by_rows ? std::pair{l, q} : std::pair{q, l});
+        }
+    }
+    if (by_rows) return;
+    s.row_start.assign(static_cast<size_t>(rows) + 1, 0);
+    for (const auto& cell : s.cells) ++s.row_start[static_cast<size_t>(cell.first) + 1];
+    for (size_t r = 1; r < s.row_start.size(); ++r) s.row_start[r] += s.row_start[r - 1];
+    s.sorted.resize(s.cells.size());
+    for (const auto& cell : s.cells) s.sorted[s.row_start[static_cast<size_t>(cell.first)]++] = cell;
+    s.cells.swap(s.sorted);
+}
+
 // The local minima of the tile's cells, decided on the fixed-order kernel's values.
 // The intervals settle most comparisons: a neighbour whose upper bound is below the
 // cell's lower bound is smaller whatever the rounding, one whose lower bound is above
@@ -511,46 +619,14 @@ void decide_cell(const FrameFeatures& f, const CandidateSearchOptions& o, const 
 // interval meets it (and is more than one float wide) are computed exactly. So the
 // result is the local-minimum rule on the exact matrix, cell for cell.
 void decide_tile_minima(const FrameFeatures& f, const CandidateSearchOptions& o, const TileSpan& t, TileScratch& s) {
-    const std::int32_t N = f.frames;
     const TileView m{t};
     BridgeLists bridges;
     const double keep_below = std::max(o.threshold, o.bridge_threshold);
     // The largest float ≤ keep_below: for a float lo, lo ≤ keep_f ⇔ double(lo) ≤ keep_below.
     float keep_f = static_cast<float>(keep_below);
     if (static_cast<double>(keep_f) > keep_below) keep_f = std::nextafter(keep_f, -std::numeric_limits<float>::infinity());
-    const std::int32_t first = t.cj0 - t.ej0, width = t.cj1 - t.cj0;
-    s.mask.resize(static_cast<size_t>(width + 8));
-    std::uint8_t* __restrict mask = s.mask.data();
-    for (std::int32_t i = t.ci0; i < t.ci1; ++i) {
-        const float* __restrict row = t.lo + m.at(i, t.ej0);  // row[j − ej0]: lower bounds
-        // The valid pairs (counted) and the cells that may be kept (0 ≤ lo ≤ keep_below; absent
-        // pairs not), a byte each, in one branch-free loop (`&`, not `&&`: it vectorises); the
-        // marked cells are then visited eight bytes at a time.
-        std::int64_t evaluated = 0;
-        for (std::int32_t c = 0; c < width; ++c) {
-            const float v = row[first + c];
-            evaluated += (v >= 0.0f) & (v < kPairInvalid);
-            mask[c] = static_cast<std::uint8_t>((v >= 0.0f) & (v <= keep_f));
-        }
-        s.evaluations += evaluated;
-        if (o.plot)  // (the picture shows the lower bounds: it is not part of the graph)
-            for (std::int32_t j = t.cj0; j < t.cj1; ++j) {
-                const float v = row[j - t.ej0];
-                if (!(v >= 0.0f && v < kPairInvalid)) continue;
-                const size_t px = static_cast<size_t>(static_cast<std::int64_t>(i) * o.plot_size / N);
-                const size_t py = static_cast<size_t>(static_cast<std::int64_t>(j) * o.plot_size / N);
-                float& pixel = s.plot[px * static_cast<size_t>(o.plot_size) + py];
-                pixel = std::min(pixel, v);
-            }
-        for (std::int32_t c = width; c % 8 != 0; ++c) mask[c] = 0;
-        for (std::int32_t word = 0; word < width; word += 8) {
-            std::uint64_t bits;
-            std::memcpy(&bits, mask + word, sizeof bits);
-            if (bits == 0) continue;
-            for (std::int32_t c = word; c < word + 8; ++c)
-                if (mask[c]) decide_cell(f, o, m, i, t.cj0 + c, keep_below, bridges, s);
-        }
-    }
+    collect_keepable(o, t, keep_f, f.frames, s);
+    for (const auto& [r, c] : s.cells) decide_cell(f, o, m, t.ci0 + r, t.cj0 + c, keep_below, bridges, s);
     for (const auto& [clips, best] : bridges) s.found.insert(s.found.end(), best.begin(), best.end());
 }
 
@@ -695,27 +771,15 @@ void run_tile_pair(const FrameFeatures& f, const CandidateSearchOptions& o, cons
     const size_t stride = static_cast<size_t>(c1 - c0);
     if (!p.empty()) {
         const size_t at = static_cast<size_t>(p.ei0 - r0) * stride + static_cast<size_t>(p.ej0 - c0);
-        p.lo = s.box_lo.data() + at, p.stride = stride;
+        p.lo = s.box_lo.data() + at, p.lo_i_step = stride, p.lo_j_step = 1;
         p.hi = s.box_hi.data() + at, p.hi_i_step = stride, p.hi_j_step = 1;
         decide_tile_minima(f, o, p, s);
     }
     if (q.empty()) return;
-    const std::int32_t rows = q.ei1 - q.ei0, cols = q.ej1 - q.ej0;
-    const size_t ucols = static_cast<size_t>(cols);
-    s.d.ensure(static_cast<size_t>(rows) * ucols);
-    // q[r][c] = box[c + q.ej0 − k + 1 − r0][r + q.ei0 + k − 1 − c0]: the lower bounds copied
-    // (every row is scanned), in 32 × 32 blocks (cache); the upper bounds read in place.
+    // q[r][c] = box[c + q.ej0 − k + 1 − r0][r + q.ei0 + k − 1 − c0]: both bounds read in place,
+    // transposed (decide_tile_minima scans such a tile along the box's rows).
     const size_t br = static_cast<size_t>(q.ej0 - k + 1 - r0), bc = static_cast<size_t>(q.ei0 + k - 1 - c0);
-    constexpr std::int32_t kBlock = 32;
-    for (std::int32_t r_0 = 0; r_0 < rows; r_0 += kBlock)
-        for (std::int32_t c_0 = 0; c_0 < cols; c_0 += kBlock)
-            for (std::int32_t r = r_0; r < std::min(r_0 + kBlock, rows); ++r)
-                for (std::int32_t c = c_0; c < std::min(c_0 + kBlock, cols); ++c) {
-                    const size_t from = (br + static_cast<size_t>(c)) * stride + bc + static_cast<size_t>(r);
-                    const size_t to = static_cast<size_t>(r) * ucols + static_cast<size_t>(c);
-                    s.d[to] = s.box_lo[from];
-                }
-    q.lo = s.d.data(), q.stride = ucols;
+    q.lo = s.box_lo.data() + br * stride + bc, q.lo_i_step = 1, q.lo_j_step = stride;
     q.hi = s.box_hi.data() + br * stride + bc, q.hi_i_step = 1, q.hi_j_step = stride;
     decide_tile_minima(f, o, q, s);
 }
@@ -743,7 +807,6 @@ CandidateSearchResult find_transition_candidates(const FrameFeatures& f, const C
         for (TileScratch& s : scratch) {
             s.ca.ensure(ring * frames), s.cb.ensure(ring * frames), s.cy.ensure(ring * frames);
             s.box_lo.ensure(side * side), s.box_hi.ensure(side * side);
-            s.d.ensure(side * side);
         }
     }
     if (o.plot)

@@ -71,6 +71,11 @@ double feature_pair_distance(const FrameFeatures& f, std::int32_t i, std::int32_
 double reference_pair_distance(const ClipDatabase& db, std::span<const vec3> positions, int window, double scale,
                                std::int32_t i, std::int32_t j, PlanarTransform* align = nullptr);
 
+// Only the alignment reference_pair_distance computes (the same bits), without the
+// distance: what placing a candidate needs.
+PlanarTransform reference_pair_alignment(const ClipDatabase& db, std::span<const vec3> positions, int window,
+                                         std::int32_t i, std::int32_t j);
+
 struct TransitionCandidate {
     std::int32_t from_frame = 0;  // i (global frame)
     std::int32_t to_frame = 0;    // j (global frame)
