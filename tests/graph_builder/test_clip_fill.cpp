@@ -7,6 +7,7 @@
 #include "graph_builder/fill_eval.hpp"
 #include "runtime/errors/import_error.hpp"
 #include "runtime/formats/asf_amc.hpp"
+#include "runtime/formats/bvh.hpp"
 #include "runtime/math/det_math.hpp"
 #include "tests/test_support.hpp"
 
@@ -198,6 +199,13 @@ TEST_CASE("fill: groups resolve on the CMU skeleton", "[fill]") {
     CHECK(hidden_names("right_arm") == "rhumerus rradius rwrist rhand rfingers rthumb ");
     CHECK(hidden_names("head") == "lowerneck upperneck head ");
     CHECK(hidden_names("legs,lhumerus") == "lfemur ltibia lfoot ltoes rfemur rtibia rfoot rtoes lhumerus lradius lwrist lhand lfingers lthumb ");
+    // The cgspeed BVH conversion names the upper arm LeftShoulder (its collar is LeftCollar).
+    const Skeleton b = load_bvh_file(dir + "/cmu_bvh_131/131_01.bvh").skeleton;
+    std::string arms;
+    const std::vector<bool> h = resolve_hidden_joints(b, "arms", "--hide");
+    for (int j = 0; j < b.joint_count(); ++j)
+        if (h[static_cast<size_t>(j)]) arms += b.joint_names[static_cast<size_t>(j)] + " ";
+    CHECK(arms == "LeftShoulder LeftElbow LeftWrist lhand LFingers LThumb RightShoulder RightElbow RightWrist rhand RFingers RThumb ");
 }
 
 namespace {
