@@ -23,8 +23,8 @@ const std::vector<std::string>& group_names(const std::string& group) {
     static const std::vector<std::pair<std::string, std::vector<std::string>>> table = {
         {"left_leg", {"lfemur", "leftupleg", "leftupperleg", "lefthip", "leftthigh", "l_hip", "lthigh"}},
         {"right_leg", {"rfemur", "rightupleg", "rightupperleg", "righthip", "rightthigh", "r_hip", "rthigh"}},
-        {"left_arm", {"lhumerus", "leftarm", "leftupperarm", "l_upperarm", "lshoulder"}},
-        {"right_arm", {"rhumerus", "rightarm", "rightupperarm", "r_upperarm", "rshoulder"}},
+        {"left_arm", {"lhumerus", "leftarm", "leftupperarm", "l_upperarm", "lshoulder", "leftshoulder"}},
+        {"right_arm", {"rhumerus", "rightarm", "rightupperarm", "r_upperarm", "rshoulder", "rightshoulder"}},
         {"head", {"lowerneck", "neck", "neck1", "head"}},
     };
     for (const auto& [g, names] : table)
@@ -320,6 +320,12 @@ FillMatch fill_gap(Clip& clip, const FillGap& gap, const FillDatabase* db, const
     std::vector<int> hidden;
     for (int j = 0; j < clip.joint_count(); ++j)
         if (gap.hidden[static_cast<size_t>(j)]) hidden.push_back(j);
+    std::vector<FillMapping> hindsight;  // evaluation only: the match chosen seeing the hidden joints
+    if (o.oracle_match && o.method == FillMethod::graph && db && !db->clips.empty() && !hidden.empty()) {
+        FillGap all_visible = gap;
+        all_visible.hidden.assign(gap.hidden.size(), false);
+        hindsight = search_fill_motion(clip, all_visible, *db, o);
+    }
     const FillMethod baseline = o.method == FillMethod::hold ? FillMethod::hold : FillMethod::slerp;
     const size_t n = static_cast<size_t>(clip.joint_count());
     for (int f = gap.first; f <= gap.last; ++f)
@@ -329,7 +335,7 @@ FillMatch fill_gap(Clip& clip, const FillGap& gap, const FillDatabase* db, const
         }
     FillMatch match;
     if (o.method != FillMethod::graph || !db || db->clips.empty() || hidden.empty()) return match;
-    const std::vector<FillMapping> matches = search_fill_motion(clip, gap, *db, o);
+    const std::vector<FillMapping> matches = o.oracle_match ? hindsight : search_fill_motion(clip, gap, *db, o);
     if (matches.empty()) return match;
     match = matches.front().match;
     const double gap_s = (gap.last - gap.first + 1) / clip.frame_rate;

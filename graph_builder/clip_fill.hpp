@@ -67,6 +67,15 @@ struct FillOptions {
     int refine_candidates = 8;     // coarse matches refined with DTW
     double ease_s = 0.1;           // velocity ease at each border (0: none)
     int blend_matches = 5;         // the best refined matches averaged (weights ∝ 1 / distance)
+    // Weight (against 1 per joint) of the root's position 0.1 s ahead in each
+    // frame's point cloud: compares the root's velocity in the body's frame, which
+    // the per-frame alignment otherwise discards (docs/fill.md).
+    double velocity_weight = 10.0;
+    // Evaluation only (`fill-eval --oracle-match`): the search also sees the hidden
+    // joints' values inside the gap — which the clip must still hold (the truth) —
+    // so the match is the best in hindsight. Separates a wrong match from what
+    // even the best database motion gets wrong.
+    bool oracle_match = false;
 };
 
 // Which database motion filled a gap (graph method).

@@ -118,6 +118,7 @@ FillEvalResult evaluate_fill(const std::vector<Clip>& clips, const std::vector<s
                 ++result.skipped;
                 continue;
             }
+            std::vector<Accumulator> mine(3);
             for (int t = 0; t < o.trials; ++t) {
                 FillGap g;
                 g.hidden = hidden;
@@ -129,8 +130,12 @@ FillEvalResult evaluate_fill(const std::vector<Clip>& clips, const std::vector<s
                     fo.method = methods[m];
                     (void)fill_gap(filled, g, &db, fo);
                     measure(filled, truth, g, points, p95, result.cm_per_unit, acc[m * gaps + gi]);
+                    measure(filled, truth, g, points, p95, result.cm_per_unit, mine[m]);
                 }
             }
+            for (size_t m = 0; m < 3; ++m)
+                result.per_clip.push_back({static_cast<int>(c), methods[m], o.gaps_s[gi], mine[m].cases,
+                                           mine[m].count > 0 ? mine[m].sum / mine[m].count : 0.0});
         }
     }
     for (size_t m = 0; m < 3; ++m)

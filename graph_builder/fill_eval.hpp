@@ -29,8 +29,18 @@ struct FillEvalRow {
     double continuity_worst = 0.0;
 };
 
+// One clip's share of a row (which clips the error comes from).
+struct FillEvalClipRow {
+    int clip = 0;                      // index into the clips given
+    FillMethod method = FillMethod::graph;
+    double gap_s = 0.0;
+    int cases = 0;
+    double mean_cm = 0.0;
+};
+
 struct FillEvalResult {
     std::vector<FillEvalRow> rows;     // method-major: graph, slerp, hold; then gap lengths in order
+    std::vector<FillEvalClipRow> per_clip;  // clip-major, then gap length, then method; clips too short left out
     int skipped = 0;                   // (clip, gap length) pairs with a clip too short for the gap
     double cm_per_unit = 1.0;
 };

@@ -14,6 +14,7 @@ namespace {
 // them: a clip that truly follows the database is found exactly).
 constexpr double kScales[] = {0.7, 0.8, 0.9, 1.0, 1.1, 1.25, 1.4};
 constexpr int kCoarseFrames = 24;  // query frames the coarse search compares
+constexpr int kAhead = 3;          // database frames to the root's look-ahead point (0.1 s)
 
 // The clip around the gap at the database rate: per query frame, the joints that
 // count (visible ones inside the gap, all outside) and their model positions.
@@ -22,6 +23,11 @@ struct Query {
     int frames = 0;
     std::vector<int> visible, all;
     std::vector<bool> in_gap;
+    int root = -1;
+    // Per frame: first the root's position kAhead database frames later (so the
+    // one alignment of the frame also compares the root's velocity in the body's
+    // frame: how fast and which way it moves, which per-frame alignment alone
+    // discards), then the frame's joints.
     std::vector<vec3> points;          // per frame, its joints' positions in order
     std::vector<size_t> offset;        // first point of each frame
     const std::vector<int>& joints(int i) const { return in_gap[static_cast<size_t>(i)] ? visible : all; }
@@ -36,6 +42,7 @@ Query build_query(const Clip& clip, const FillGap& gap, double rate, double wind
     q.frames = static_cast<int>(std::floor((t1 - q.t0) * rate + 1e-9)) + 1;
     const int n = clip.joint_count();
     for (int j = 0; j < n; ++j) {
+        if (clip.skeleton.parents[static_cast<size_t>(j)] == kNoParent && q.root < 0) q.root = j;
         q.all.push_back(j);
         if (!gap.hidden[static_cast<size_t>(j)]) q.visible.push_back(j);
     }
@@ -45,14 +52,24 @@ Query build_query(const Clip& clip, const FillGap& gap, double rate, double wind
         const double t = q.t0 + i / rate;
         // Inside the gap (with a half-frame margin at the clip's rate) only visible joints count.
         q.in_gap.push_back(t > t_first - 0.5 / r_in && t < t_last + 0.5 / r_in);
-        sample_clip(clip, t, ClipWrap::clamp, lr, lt);
         const LocalToModelJob fk{clip.skeleton.parents, {lr, lt}, {mr, mp}};
+        sample_clip(clip, t + kAhead / rate, ClipWrap::clamp, lr, lt);
         (void)fk.run();
         q.offset.push_back(q.points.size());
+        q.points.push_back(mp[static_cast<size_t>(q.root)]);
+        sample_clip(clip, t, ClipWrap::clamp, lr, lt);
+        (void)fk.run();
         for (int j : q.joints(i)) q.points.push_back(mp[static_cast<size_t>(j)]);
     }
     q.offset.push_back(q.points.size());
     return q;
+}
+
+// The look-ahead point's weight first, then 1 per joint.
+std::vector<float> point_weights(const Query& q, double velocity_weight) {
+    std::vector<float> w(q.all.size() + 1, 1.0f);
+    w[0] = static_cast<float>(velocity_weight);
+    return w;
 }
 
 struct Candidate {
@@ -82,6 +99,8 @@ double frame_distance(const Query& q, int i, const FillDatabase& db, int c, doub
                       const std::vector<float>& w) {
     const int joints = db.skeleton.joint_count();
     b.clear();
+    const double last = db.clips[static_cast<size_t>(c)].frame_count - 1;
+    b.push_back(db_point(db, c, joints, std::min(frame + kAhead, last), q.root));
     for (int j : q.joints(i)) b.push_back(db_point(db, c, joints, frame, j));
     const size_t k = q.offset[static_cast<size_t>(i)];
     const std::span<const vec3> a(q.points.data() + k, b.size());
@@ -96,13 +115,13 @@ Candidate score(const Query& q, const std::vector<int>& sample, const FillDataba
     return Candidate{sum / static_cast<double>(sample.size()), c, start, scale};
 }
 
-std::vector<Candidate> coarse_search(const Query& q, const FillDatabase& db) {
+std::vector<Candidate> coarse_search(const Query& q, const FillDatabase& db, double velocity_weight) {
     std::vector<int> sample;
     const int stride = std::max(1, (q.frames + kCoarseFrames - 1) / kCoarseFrames);
     for (int i = 0; i < q.frames; i += stride) sample.push_back(i);
     if (sample.back() != q.frames - 1) sample.push_back(q.frames - 1);
     std::vector<vec3> b;
-    const std::vector<float> w(q.all.size(), 1.0f);
+    const std::vector<float> w = point_weights(q, velocity_weight);
     std::vector<Candidate> all;
     for (int c = 0; c < static_cast<int>(db.clips.size()); ++c) {
         const int last = db.clips[static_cast<size_t>(c)].frame_count - 1;
@@ -139,9 +158,10 @@ std::vector<Candidate> distinct_best(const std::vector<Candidate>& sorted, int c
 // (fixed ends, steps (1,1), (1,0), (0,1), a band around the diagonal), with the
 // per-frame distance. Fills `db_frame` (per query frame, the mean matched
 // database frame) and returns the mean cost per point along the path.
-double dtw_refine(const Query& q, const FillDatabase& db, const Candidate& cand, std::vector<double>& db_frame) {
+double dtw_refine(const Query& q, const FillDatabase& db, const Candidate& cand, double velocity_weight,
+                  std::vector<double>& db_frame) {
     std::vector<vec3> b;
-    const std::vector<float> w(q.all.size(), 1.0f);
+    const std::vector<float> w = point_weights(q, velocity_weight);
     const int first = static_cast<int>(std::floor(cand.start));
     const int last = std::min(db.clips[static_cast<size_t>(cand.clip)].frame_count - 1,
                               static_cast<int>(std::ceil(cand.start + (q.frames - 1) * cand.scale)));
@@ -218,11 +238,11 @@ std::vector<FillMapping> search_fill_motion(const Clip& clip, const FillGap& gap
     const Query q = build_query(clip, gap, db.rate, o.window_s);
     if (q.frames < 2 || q.visible.empty()) return out;
     const int refine = std::max({1, o.refine_candidates, o.blend_matches});
-    for (const Candidate& c : distinct_best(coarse_search(q, db), refine, q.frames)) {
+    for (const Candidate& c : distinct_best(coarse_search(q, db, o.velocity_weight), refine, q.frames)) {
         FillMapping m;
         m.query_t0 = q.t0;
         m.query_rate = db.rate;
-        const double d = dtw_refine(q, db, c, m.db_time);
+        const double d = dtw_refine(q, db, c, o.velocity_weight, m.db_time);
         if (!(d < std::numeric_limits<double>::infinity())) continue;
         m.match = {true, c.clip, c.start / db.rate, c.scale, d, 1.0};
         smooth_mapping(m.db_time);

@@ -54,6 +54,7 @@ for name, n in ca:
 assert changed > 1000, changed
 PY"
 check "clip fill-eval is deterministic for a seed" bash -c "'$bin' clip fill-eval --asf '$asf' --clips $m/16_1*.amc --hide left_leg --gaps 0.5,1 --trials 1 --seed 5 --json >e1.json && '$bin' clip fill-eval --asf '$asf' --clips $m/16_1*.amc --hide left_leg --gaps 0.5,1 --trials 1 --seed 5 --json >e2.json && cmp e1.json e2.json && grep -q '\"method\":\"slerp\"' e1.json"
+check "fill-eval --per-clip --oracle-match report each clip and say the match was in hindsight" bash -c "'$bin' clip fill-eval --asf '$asf' --clips $m/16_1*.amc --hide left_leg --gaps 1 --trials 1 --json --per-clip --oracle-match >e3.json && python3 -c \"import json; r=json.load(open('e3.json')); assert r['oracle_match'] is True; p=r['per_clip']; assert len(p)==12 and {x['method'] for x in p}=={'graph','slerp','hold'}; assert sum(x['cases'] for x in p if x['method']=='graph')==r['rows'][0]['cases']\""
 expect_error "the input in its own database is refused" 2 "must not be in its own database (add --allow-self" "$bin" clip fill "$m/16_15.amc" --asf "$asf" --database "$m/16_15.amc" --hide legs --frames 1:20 -o x.bvh
 check "--allow-self lets it through" bash -c "'$bin' clip fill '$m/16_15.amc' --asf '$asf' --database '$m/16_15.amc' --allow-self --hide legs --frames 1:20 -o x.bvh >/dev/null"
 expect_error "an unknown joint is refused" 2 "--hide: no joint or group named 'lknee'" "$bin" clip fill "$m/16_15.amc" --asf "$asf" --database "${db[@]}" --hide lknee --frames 1:20 -o x.bvh
