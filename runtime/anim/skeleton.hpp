@@ -44,16 +44,6 @@ Pose rest_pose(const Skeleton& skeleton);
 // Forward kinematics: local transforms → model space, one pass in joint order.
 // A job (runtime/anim/pose_spans.hpp): validate() checks the sizes (the model
 // spans may be longer than the skeleton) and the topological order.
-//
-// run() groups the joints by depth (a joint's parent is always one level up, so
-// the joints of a level are independent) and solves four joints of a level at a
-// time in 4-lane vectors (GCC/Clang vector extensions: SSE2 on x86-64, NEON on
-// AArch64), each lane doing quat_mul and quat_rotate's operations in their
-// order: the same bits as run_reference(), the one-joint-at-a-time loop kept for
-// the tests (tests/runtime/anim/test_local_to_model_job.cpp compares them bit for
-// bit). Skeletons over kLocalToModelBatchedJoints joints take the reference loop.
-inline constexpr std::size_t kLocalToModelBatchedJoints = 256;
-
 struct LocalToModelJob {
     std::span<const int> parents;
     LocalPoseInput input;
@@ -61,7 +51,6 @@ struct LocalToModelJob {
 
     bool validate() const;
     [[nodiscard]] bool run() const;
-    [[nodiscard]] bool run_reference() const;
 };
 
 }  // namespace marionette
