@@ -68,16 +68,6 @@ findings=build/fuzz/findings
 rm -rf "$run" "$findings"
 mkdir -p "$run" "$findings"
 
-# User + system CPU seconds of this shell's finished children (each run_one runs
-# in its own subshell, so the difference around the fuzzer is the fuzzer's).
-cpu_seconds_of_children() {
-  local t
-  t=$(times | tail -1)
-  awk -v t="$t" 'BEGIN { n = split(t, f, " "); s = 0
-    for (i = 1; i <= n; i++) { split(f[i], ms, "m"); sub("s", "", ms[2]); s += ms[1] * 60 + ms[2] }
-    printf "%.1f\n", s }'
-}
-
 run_one() {
   local name=$1 max_len=$2 timeout=$3 dict=$4
   local exe="$bin/fuzz_$name" work="$run/$name" log="$run/$name.log"
@@ -88,12 +78,11 @@ run_one() {
               -malloc_limit_mb=512 -print_final_stats=1 -artifact_prefix="$findings/$name/")
   [[ "$dict" != - ]] && args+=(-dict="tests/fuzz/dict/$dict")
   [[ -n "${FUZZ_RUNS:-}" ]] && args+=(-runs="$FUZZ_RUNS")
-  local rc=0 t0 t1
-  t0=$(cpu_seconds_of_children)
-  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 "$exe" "${args[@]}" "$work" "${seeds[@]}" >"$log" 2>&1 || rc=$?
-  t1=$(cpu_seconds_of_children)
+  local rc=0 TIMEFORMAT='%U %S'   # bash's `time`: the fuzzer's user and system CPU seconds
+  { time UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 "$exe" "${args[@]}" "$work" "${seeds[@]}" >"$log" 2>&1; } \
+    2>"$run/$name.time" || rc=$?
   echo "$rc" >"$run/$name.rc"
-  awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.0f\n", b - a }' >"$run/$name.cpu"
+  awk '{ printf "%.0f\n", $1 + $2 }' "$run/$name.time" >"$run/$name.cpu"
   if ((grow)) && [[ "$rc" == 0 ]]; then
     "$exe" -merge=1 -max_len="$max_len" "tests/fuzz/corpus/$name" "$work" >>"$log" 2>&1
   fi
