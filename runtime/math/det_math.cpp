@@ -1,6 +1,7 @@
 #include "runtime/math/det_math.hpp"
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -75,8 +76,12 @@ void sin_cos(double x, double& s, double& c) {
         return;
     }
     // Very large arguments lose all meaning in float simulation anyway; reduce
-    // them coarsely first so q stays in range for the exact split.
-    if (x > 1.0e6 || x < -1.0e6) x = x - kTwoPi * std::nearbyint(x / kTwoPi);
+    // them first so q stays in range for the exact split. fmod is exact (the
+    // remainder of two doubles is representable), so this is the same on every
+    // machine; x - 2pi * nearbyint(x / 2pi) was not a reduction above ~1e22 (a
+    // stick program's `from=7.7e77` left q out of int64's range: UB, found by
+    // fuzz_stick_program).
+    if (x > 1.0e6 || x < -1.0e6) x = std::fmod(x, kTwoPi);
     const double q = std::nearbyint(x / kHalfPi);
     const double r = (x - q * kPio2Hi) - q * kPio2Lo;
     const double sr = sin_poly(r);
