@@ -105,10 +105,28 @@ Outcome validate_key_pose_graph(const KeyPoseGraph& g) {
         return Outcome::failure("frame_rate, leg_length and step must be positive numbers");
     if (!(g.link_threshold >= 0.0) || !(g.thin_threshold >= 0.0))
         return Outcome::failure("thresholds must be numbers >= 0");
-    for (size_t p = 0; p < g.poses.size(); ++p)
-        if (g.poses[p].rotations.size() != J || g.poses[p].translations.size() != J)
+    double weight = 0.0;
+    for (size_t j = 0; j < J; ++j) {
+        const vec3 o = g.skeleton.rest_offsets[j];
+        if (!(g.joint_weights[j] >= 0.0f) || !std::isfinite(g.joint_weights[j]) || !std::isfinite(o.x + o.y + o.z))
+            return Outcome::failure("joint " + std::to_string(j) + ": weight must be a finite number >= 0 and the offset finite");
+        weight += g.joint_weights[j];
+    }
+    if (!(weight > 0.0)) return Outcome::failure("the joint weights add up to 0: no pose difference could be measured");
+    for (size_t p = 0; p < g.poses.size(); ++p) {
+        const KeyPose& k = g.poses[p];
+        if (k.rotations.size() != J || k.translations.size() != J)
             return Outcome::failure("pose " + std::to_string(p) + " does not have one rotation and one translation per joint (" +
                                     std::to_string(J) + ")");
+        for (size_t j = 0; j < J; ++j) {
+            const quat q = k.rotations[j];
+            const vec3 t = k.translations[j];
+            const double norm = static_cast<double>(quat_dot(q, q));
+            if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-3 || !std::isfinite(t.x + t.y + t.z))
+                return Outcome::failure("pose " + std::to_string(p) + ", joint " + std::to_string(j) +
+                                        ": the rotation must be a unit quaternion and the translation finite");
+        }
+    }
     const std::int32_t n = static_cast<std::int32_t>(g.poses.size());
     for (size_t e = 0; e < g.edges.size(); ++e) {
         const KeyPoseEdge& k = g.edges[e];
@@ -123,14 +141,23 @@ Outcome validate_key_pose_graph(const KeyPoseGraph& g) {
     return Outcome::success();
 }
 
-double key_pose_difference(const KeyPoseGraph& g, int a, int b, PlanarTransform* align) {
-    const std::vector<vec3> pa = placed_positions(g, g.poses[static_cast<size_t>(a)], {});
-    const std::vector<vec3> pb = placed_positions(g, g.poses[static_cast<size_t>(b)], {});
+namespace {
+
+// The pose difference of two posed point clouds (b aligned onto a), leg lengths².
+double cloud_difference(const KeyPoseGraph& g, const std::vector<vec3>& pa, const std::vector<vec3>& pb,
+                        PlanarTransform* align) {
     const PlanarTransform t = align_point_clouds(pa, pb, g.joint_weights);
     if (align) *align = t;
     double weight = 0.0;
     for (float w : g.joint_weights) weight += w;
     return planar_cloud_distance(pa, pb, g.joint_weights, t) / (weight * g.leg_length * g.leg_length);
+}
+
+}  // namespace
+
+double key_pose_difference(const KeyPoseGraph& g, int a, int b, PlanarTransform* align) {
+    return cloud_difference(g, placed_positions(g, g.poses[static_cast<size_t>(a)], {}),
+                            placed_positions(g, g.poses[static_cast<size_t>(b)], {}), align);
 }
 
 void link_key_poses(KeyPoseGraph& g) {
@@ -156,15 +183,33 @@ KeyPoseGraph build_key_pose_graph(const ClipDatabase& db, const KeyPoseParams& p
     std::vector<Minimum> minima = speed_minima(db, positions, g.leg_length, std::max(params.minimum_neighbourhood, 1));
     std::sort(minima.begin(), minima.end(),
               [](const Minimum& a, const Minimum& b) { return a.speed != b.speed ? a.speed < b.speed : a.frame < b.frame; });
-    // Differences of all pairs of minima (lower global frame first, so each pair has one value).
+    // Every minimum as a key pose, and the differences of all pairs (the earlier
+    // frame first, as between the graph's ids), with the graph's own difference, so
+    // the thinning guarantee holds exactly for the poses kept.
+    std::vector<std::int32_t> clip_first(db.clips.size(), 0);
+    for (size_t c = 1; c < db.clips.size(); ++c) clip_first[c] = clip_first[c - 1] + db.clips[c - 1].frame_count;
     const size_t m = minima.size();
+    std::vector<KeyPose> candidates;
+    std::vector<std::vector<vec3>> posed;
+    for (const Minimum& mk : minima) {
+        const Clip& clip = db.clips[static_cast<size_t>(mk.clip)];
+        const int f = mk.frame - clip_first[static_cast<size_t>(mk.clip)];
+        const size_t J = static_cast<size_t>(clip.joint_count());
+        candidates.push_back({clip.name, f, mk.speed, {clip.frame_rotations(f), clip.frame_rotations(f) + J},
+                              {clip.frame_translations(f), clip.frame_translations(f) + J}});
+        posed.push_back(placed_positions(g, candidates.back(), {}));
+    }
     std::vector<double> d(m * m, 0.0), all;
     for (size_t a = 0; a < m; ++a)
         for (size_t b = a + 1; b < m; ++b) {
-            const std::int32_t i = std::min(minima[a].frame, minima[b].frame), j = std::max(minima[a].frame, minima[b].frame);
-            d[a * m + b] = d[b * m + a] = reference_pair_distance(db, positions, 1, g.leg_length, i, j);
+            const bool a_first = minima[a].frame < minima[b].frame;
+            d[a * m + b] = d[b * m + a] = cloud_difference(g, posed[a_first ? a : b], posed[a_first ? b : a], nullptr);
             all.push_back(d[a * m + b]);
         }
+    if (m < 2 && (params.thin_threshold <= 0.0 || params.link_threshold <= 0.0))
+        throw std::invalid_argument(std::to_string(m) + " speed minima in " + std::to_string(db.frame_count()) +
+                                    " frames: too few to set the thresholds from percentiles (give --thin and --link, "
+                                    "or longer clips)");
     g.thin_threshold = params.thin_threshold > 0.0 ? params.thin_threshold : percentile_of(all, params.thin_percentile);
     g.link_threshold = params.link_threshold > 0.0 ? params.link_threshold : percentile_of(all, params.link_percentile);
     if (g.link_threshold <= g.thin_threshold)
@@ -179,17 +224,7 @@ KeyPoseGraph build_key_pose_graph(const ClipDatabase& db, const KeyPoseParams& p
         if (far) kept.push_back(a);
     }
     std::sort(kept.begin(), kept.end(), [&](size_t a, size_t b) { return minima[a].frame < minima[b].frame; });
-    std::vector<std::int32_t> clip_first(db.clips.size(), 0);
-    for (size_t c = 1; c < db.clips.size(); ++c) clip_first[c] = clip_first[c - 1] + db.clips[c - 1].frame_count;
-    for (size_t k : kept) {
-        const Minimum& mk = minima[k];
-        const Clip& clip = db.clips[static_cast<size_t>(mk.clip)];
-        const int f = mk.frame - clip_first[static_cast<size_t>(mk.clip)];
-        const size_t J = static_cast<size_t>(clip.joint_count());
-        KeyPose pose{clip.name, f, mk.speed, {clip.frame_rotations(f), clip.frame_rotations(f) + J},
-                     {clip.frame_translations(f), clip.frame_translations(f) + J}};
-        g.poses.push_back(std::move(pose));
-    }
+    for (size_t k : kept) g.poses.push_back(std::move(candidates[k]));
     link_key_poses(g);
     if (report) {
         report->frames = db.frame_count();
@@ -260,10 +295,12 @@ std::vector<std::int32_t> key_pose_path(const KeyPoseGraph& g, int from, int to,
 
 namespace {
 
-void append_blend(Clip& out, const KeyPoseGraph& g, const KeyPose& a, const PlanarTransform& wa, const KeyPose& b,
-                  const PlanarTransform& wb, int frames) {
+// frames + 1 poses from a (placed by wa) to b (placed by wb), smoothstep timed:
+// rotations slerped, translations lerped, appended to the flat arrays.
+void blend_poses(const KeyPoseGraph& g, const KeyPose& a, const PlanarTransform& wa, const KeyPose& b,
+                 const PlanarTransform& wb, int frames, std::vector<quat>& rotations, std::vector<vec3>& translations) {
     const size_t J = static_cast<size_t>(g.skeleton.joint_count());
-    for (int i = 0; i < frames; ++i) {
+    for (int i = 0; i <= frames; ++i) {
         const double s = static_cast<double>(i) / frames;
         const float u = static_cast<float>(s * s * (3.0 - 2.0 * s));  // smoothstep
         for (size_t j = 0; j < J; ++j) {
@@ -275,11 +312,56 @@ void append_blend(Clip& out, const KeyPoseGraph& g, const KeyPose& a, const Plan
                 ta = apply_planar(wa, ta);
                 tb = apply_planar(wb, tb);
             }
-            out.rotations.push_back(quat_slerp(ra, rb, u));
-            out.translations.push_back(lerp(ta, tb, u));
+            rotations.push_back(i == frames ? rb : quat_slerp(ra, rb, u));
+            translations.push_back(i == frames ? tb : lerp(ta, tb, u));
         }
-        ++out.frame_count;
     }
+}
+
+// Largest per-frame joint move over `count` consecutive poses (model space).
+double largest_move(const Skeleton& skeleton, const std::vector<quat>& rotations, const std::vector<vec3>& translations,
+                    int count) {
+    const size_t J = static_cast<size_t>(skeleton.joint_count());
+    std::vector<quat> model_rotations(J);
+    std::vector<vec3> previous(J), current(J);
+    double largest = 0.0;
+    for (int f = 0; f < count; ++f) {
+        const LocalToModelJob fk{skeleton.parents,
+                                 {std::span<const quat>(rotations.data() + static_cast<size_t>(f) * J, J),
+                                  std::span<const vec3>(translations.data() + static_cast<size_t>(f) * J, J)},
+                                 {model_rotations, current}};
+        if (!fk.run()) throw std::invalid_argument("skeleton is not in topological order");
+        if (f > 0)
+            for (size_t j = 0; j < J; ++j) largest = std::max(largest, static_cast<double>(glm::length(current[j] - previous[j])));
+        std::swap(previous, current);
+    }
+    return largest;
+}
+
+// One hop: sized from the largest joint displacement (chord / step frames, so the
+// smoothstep peak is 1.5 step), then lengthened while joints swinging along arcs
+// still move more than 1.5 step in a frame.
+void append_hop(Clip& out, const KeyPoseGraph& g, const KeyPose& a, const PlanarTransform& wa, const KeyPose& b,
+                const PlanarTransform& wb) {
+    const std::vector<vec3> pa = placed_positions(g, a, wa), pb = placed_positions(g, b, wb);
+    double chord = 0.0;
+    for (size_t j = 0; j < pa.size(); ++j) chord = std::max(chord, static_cast<double>(glm::length(pa[j] - pb[j])));
+    const double limit = 1.5 * g.step;
+    int frames = std::max(1, static_cast<int>(std::ceil(chord / g.step)));
+    std::vector<quat> rotations;
+    std::vector<vec3> translations;
+    for (int attempt = 0; attempt < 8; ++attempt) {
+        rotations.clear();
+        translations.clear();
+        blend_poses(g, a, wa, b, wb, frames, rotations, translations);
+        const double move = largest_move(g.skeleton, rotations, translations, frames + 1);
+        if (move <= limit) break;
+        frames = std::max(frames + 1, static_cast<int>(std::ceil(frames * move / limit)));
+    }
+    const size_t keep = static_cast<size_t>(frames) * static_cast<size_t>(g.skeleton.joint_count());  // b starts the next hop
+    out.rotations.insert(out.rotations.end(), rotations.begin(), rotations.begin() + static_cast<std::ptrdiff_t>(keep));
+    out.translations.insert(out.translations.end(), translations.begin(), translations.begin() + static_cast<std::ptrdiff_t>(keep));
+    out.frame_count += frames;
 }
 
 }  // namespace
@@ -299,15 +381,18 @@ Clip synthesize_key_pose_path(const KeyPoseGraph& g, const std::vector<std::int3
         const std::vector<vec3> pa = placed_positions(g, a, {});
         const std::vector<vec3> pb = placed_positions(g, b, {});
         const PlanarTransform next = compose_planar(world, align_point_clouds(pa, pb, g.joint_weights));
-        const std::vector<vec3> wa = placed_positions(g, a, world), wb = placed_positions(g, b, next);
-        double largest = 0.0;
-        for (size_t j = 0; j < wa.size(); ++j) largest = std::max(largest, static_cast<double>(glm::length(wa[j] - wb[j])));
-        const int frames = std::max(1, static_cast<int>(std::ceil(largest / g.step)));
-        append_blend(out, g, a, world, b, next, frames);
+        append_hop(out, g, a, world, b, next);
         world = next;
     }
+    // The last key pose itself closes the animation.
+    std::vector<quat> rotations;
+    std::vector<vec3> translations;
     const KeyPose& last = g.poses[static_cast<size_t>(path.back())];
-    append_blend(out, g, last, world, last, world, 1);
+    blend_poses(g, last, world, last, world, 1, rotations, translations);
+    const size_t J = static_cast<size_t>(g.skeleton.joint_count());
+    out.rotations.insert(out.rotations.end(), rotations.begin() + static_cast<std::ptrdiff_t>(J), rotations.end());
+    out.translations.insert(out.translations.end(), translations.begin() + static_cast<std::ptrdiff_t>(J), translations.end());
+    ++out.frame_count;
     return out;
 }
 

@@ -112,7 +112,7 @@ int key_pose_build_command(const KeyPoseBuildOptions& o) {
         try {
             g = offline::build_key_pose_graph(db, params, &report);
         } catch (const std::invalid_argument& e) {
-            throw ImportError("--link", 0, e.what());
+            throw ImportError("--key-poses", 0, e.what());
         }
     }
     write_text_file(o.output_file, offline::write_key_pose_xml(g));

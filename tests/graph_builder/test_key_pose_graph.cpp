@@ -10,6 +10,7 @@
 #include "graph_builder/key_pose_xml.hpp"
 #include "runtime/errors/import_error.hpp"
 #include "runtime/formats/bvh.hpp"
+#include "runtime/math/det_math.hpp"
 #include "tests/test_support.hpp"
 
 using namespace marionette;
@@ -67,10 +68,10 @@ void check_path(const KeyPoseGraph& g, int from, int to, const std::vector<std::
     const PopStats pops = clip_pop_stats(motion);
     INFO("path " << from << " -> " << to << ": largest move " << pops.largest << ", p95 " << pops.p95);
     CHECK(pops.largest <= 4.0 * pops.p95);
-    // No joint jumps further per frame than the interpolation allows: smoothstep peaks at
-    // 1.5× the mean rate, and slerped chains move joints along arcs a little longer than
-    // the chord the frame count is sized by (CMU-16: at most 1.76× step over the sweep).
-    CHECK(pops.largest <= 2.0 * g.step);
+    // No joint moves further in a frame than the interpolation allows: 1.5 step, the
+    // smoothstep peak at the mean rate (hops are lengthened until it holds; the
+    // margin is the BVH text's rounding).
+    CHECK(pops.largest <= 1.5 * g.step * 1.01);
 }
 
 }  // namespace
@@ -84,7 +85,7 @@ TEST_CASE("CMU-16 key poses: a path between poses of two clips exists and its BV
     // No two key poses are closer than the thinning threshold.
     for (size_t a = 0; a < g.poses.size(); ++a)
         for (size_t b = a + 1; b < g.poses.size(); ++b)
-            CHECK(key_pose_difference(g, static_cast<int>(a), static_cast<int>(b)) >= g.thin_threshold * (1.0 - 1e-6));
+            CHECK(key_pose_difference(g, static_cast<int>(a), static_cast<int>(b)) >= g.thin_threshold);
     // The first pose of the largest component and the last pose of another clip in it.
     const std::vector<std::int32_t> comp = key_pose_components(g);
     std::map<std::int32_t, int> sizes;
@@ -210,6 +211,114 @@ TEST_CASE("generated sweep: random key-pose pairs find a pop-free cheapest path 
             CHECK(key_pose_path(g, from, to) == path);  // the same answer again
         }
     }
+    WARN("CMU-16 sweep: " << found << " paths, " << none << " no path");
     CHECK(found > 60);
     CHECK(none > 0);  // the sparse graph leaves some pairs apart, and says so
+}
+
+namespace {
+
+// A generated database: a small humanoid-like tree whose joints follow sines of
+// time with per-clip stride, amplitude and length (drawn from a fixed seed).
+ClipDatabase generated_database(std::mt19937_64& random, int& clips_out) {
+    const auto uniform = [&random](double lo, double hi) {
+        return lo + (hi - lo) * static_cast<double>(random() >> 11) * (1.0 / 9007199254740992.0);
+    };
+    Skeleton s;
+    const auto add = [&](const char* name, int parent, vec3 offset) {
+        s.joint_names.emplace_back(name);
+        s.parents.push_back(parent);
+        s.rest_offsets.push_back(offset);
+    };
+    add("root", kNoParent, vec3(0, 0, 0));
+    add("spine", 0, vec3(0, 10, 0));
+    add("lhumerus", 1, vec3(5, 8, 0));
+    add("lradius", 2, vec3(0, -9, 0));
+    add("rhumerus", 1, vec3(-5, 8, 0));
+    add("lfemur", 0, vec3(3, -2, 0));
+    add("ltibia", 5, vec3(0, -15, 0));
+    add("lfoot", 6, vec3(0, -15, 0));
+    add("rfemur", 0, vec3(-3, -2, 0));
+    add("rtibia", 8, vec3(0, -15, 0));
+    add("rfoot", 9, vec3(0, -15, 0));
+    const int clips = 1 + static_cast<int>(random() % 4);
+    std::vector<Clip> list;
+    std::vector<std::string> names;
+    for (int c = 0; c < clips; ++c) {
+        Clip clip;
+        clip.name = "gen" + std::to_string(c);
+        clip.skeleton = s;
+        clip.frame_rate = 30.0;
+        clip.frame_count = 2 + static_cast<int>(random() % 150);
+        const double stride = uniform(0.4, 2.5), amplitude = uniform(0.05, 1.5), turn = uniform(-1.0, 1.0);
+        const int n = clip.joint_count();
+        clip.animated_translation.assign(static_cast<size_t>(n), false);
+        clip.animated_translation[0] = true;
+        for (int f = 0; f < clip.frame_count; ++f) {
+            const double t = f / 30.0, phase = 2.0 * 3.14159265358979 * t / stride;
+            for (int j = 0; j < n; ++j) {
+                const double a = amplitude * (0.5 * det::sin(phase + 0.7 * j) + 0.15 * det::sin(2.0 * phase + j));
+                const vec3 axis = j % 3 == 0 ? vec3(1, 0, 0) : (j % 3 == 1 ? vec3(0, 0, 1) : vec3(0, 1, 0));
+                clip.rotations.push_back(j == 0 ? quat_axis_angle(vec3(0, 1, 0), turn * t) : quat_axis_angle(axis, a));
+                clip.translations.push_back(j == 0 ? vec3(static_cast<float>(40.0 * t), 35.0f, 0.0f)
+                                                   : s.rest_offsets[static_cast<size_t>(j)]);
+            }
+        }
+        list.push_back(std::move(clip));
+        names.push_back("gen" + std::to_string(c) + ".bvh");
+    }
+    clips_out = clips;
+    return make_clip_database(std::move(list), names, LabelRules{}, 30.0);
+}
+
+}  // namespace
+
+TEST_CASE("generated databases: key-pose graphs keep their invariants or refuse clearly", "[keypose][sweep]") {
+    std::mt19937_64 random(0x4b45595053ull);  // fixed seed
+    int built = 0, refused = 0, paths = 0, no_paths = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+        int clips = 0;
+        const ClipDatabase db = generated_database(random, clips);
+        KeyPoseParams params;
+        params.thin_percentile = static_cast<double>(random() % 20);
+        params.link_percentile = params.thin_percentile + 1.0 + static_cast<double>(random() % 80);
+        INFO("trial " << trial << ": " << clips << " clips, " << db.frame_count() << " frames, percentiles "
+                      << params.thin_percentile << " / " << params.link_percentile);
+        KeyPoseGraph g;
+        try {
+            g = build_key_pose_graph(db, params);
+        } catch (const std::invalid_argument& e) {
+            // Too few minima, or percentiles that collapse onto one value (periodic clips repeat poses exactly).
+            const std::string what = e.what();
+            CHECK((what.find("too few") != std::string::npos || what.find("must be above the thinning") != std::string::npos));
+            ++refused;
+            continue;
+        }
+        ++built;
+        REQUIRE(validate_key_pose_graph(g).ok());
+        for (size_t a = 0; a < g.poses.size(); ++a)
+            for (size_t b = a + 1; b < g.poses.size(); ++b)
+                CHECK(key_pose_difference(g, static_cast<int>(a), static_cast<int>(b)) >= g.thin_threshold);
+        const std::string xml = write_key_pose_xml(g);
+        CHECK(write_key_pose_xml(parse_key_pose_xml(xml, "gen.xml")) == xml);
+        const int n = static_cast<int>(g.poses.size());
+        const std::vector<std::int32_t> comp = key_pose_components(g);
+        for (int k = 0; k < 5 && n > 0; ++k) {
+            const int from = static_cast<int>(random() % static_cast<std::uint64_t>(n));
+            const int to = static_cast<int>(random() % static_cast<std::uint64_t>(n));
+            double cost = 0.0;
+            const std::vector<std::int32_t> path = key_pose_path(g, from, to, &cost);
+            INFO(from << " -> " << to);
+            if (path.empty()) {
+                ++no_paths;
+                CHECK(comp[static_cast<size_t>(from)] != comp[static_cast<size_t>(to)]);
+            } else {
+                ++paths;
+                check_path(g, from, to, path, cost);
+            }
+        }
+    }
+    WARN("generated: " << built << " built, " << refused << " refused, " << paths << " paths, " << no_paths << " no path");
+    CHECK(built > 20);
+    CHECK(paths > 0);
 }
