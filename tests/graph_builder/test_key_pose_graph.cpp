@@ -322,3 +322,29 @@ TEST_CASE("generated databases: key-pose graphs keep their invariants or refuse 
     CHECK(built > 20);
     CHECK(paths > 0);
 }
+
+TEST_CASE("regression: a joint swinging along a wide arc still moves at most 1.5 step per frame", "[keypose]") {
+    // Kept from the generated sweep (trial 39: hops at 3.4 step when the frame count
+    // was sized by the chord only): an arm turning 170° moves its hand along an arc
+    // about 1.5× its chord.
+    KeyPoseGraph g;
+    g.skeleton.joint_names = {"root", "arm", "hand"};
+    g.skeleton.parents = {kNoParent, 0, 1};
+    g.skeleton.rest_offsets = {vec3(0.0f), vec3(0, 10, 0), vec3(0, 10, 0)};
+    g.animated_translation = {true, false, false};
+    g.joint_weights = {1.0f, 1.0f, 1.0f};
+    g.step = 1.0;
+    g.link_threshold = 1e9;
+    const std::vector<vec3> rest = {vec3(0.0f), vec3(0, 10, 0), vec3(0, 10, 0)};
+    g.poses.push_back({"c", 0, 0.0, {quat_identity(), quat_identity(), quat_identity()}, rest});
+    g.poses.push_back({"c", 9, 0.0, {quat_identity(), quat_axis_angle(vec3(0, 0, 1), 170.0 / 180.0 * 3.14159265358979), quat_identity()}, rest});
+    link_key_poses(g);
+    REQUIRE(validate_key_pose_graph(g).ok());
+    const std::vector<std::int32_t> path = key_pose_path(g, 0, 1);
+    REQUIRE(path == std::vector<std::int32_t>{0, 1});
+    const Clip motion = synthesize_key_pose_path(g, path);
+    const PopStats pops = clip_pop_stats(motion);
+    CHECK(pops.largest <= 1.5 * g.step + 1e-6);
+    CHECK(pops.largest > 1.0);  // not needlessly slow: the hop is lengthened, not padded
+    CHECK(pops.largest <= 4.0 * pops.p95);
+}
