@@ -7,6 +7,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <optional>
 
@@ -233,6 +234,8 @@ std::string write_key_pose_xml(const KeyPoseGraph& g) {
 }
 
 KeyPoseGraph parse_key_pose_xml(const std::string& text, const std::string& origin) {
+    if (text.size() > static_cast<size_t>(std::numeric_limits<int>::max()))
+        throw ImportError(origin, 0, "the file is larger than 2 GiB, more than the XML reader takes");
     const std::unique_ptr<xmlParserCtxt, void (*)(xmlParserCtxtPtr)> context(xmlNewParserCtxt(), xmlFreeParserCtxt);
     if (!context) throw ImportError(origin, 0, "cannot create an XML parser (out of memory)");
     const std::unique_ptr<xmlDoc, void (*)(xmlDocPtr)> doc(
