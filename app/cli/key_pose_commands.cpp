@@ -34,6 +34,7 @@ offline::KeyPoseGraph load_key_pose_graph(const std::string& path) {
 // A pose id, or CLIP:FRAME (the key pose of that clip nearest the frame, the earlier on a tie).
 int parse_pose(const offline::KeyPoseGraph& g, const std::string& text, const std::string& option) {
     const int n = static_cast<int>(g.poses.size());
+    if (n == 0) throw ImportError(option, 0, "the graph has no key poses to start or end at");
     const size_t colon = text.find_last_of(':');
     if (colon == std::string::npos) {
         int id = -1;
