@@ -18,6 +18,8 @@ packages=(
   libimgui-dev
   # motion graph: BLAS for the distance matrix
   libopenblas-dev
+  # key-pose graphs saved and loaded as XML (graph_builder/key_pose_xml.cpp)
+  libxml2-dev
   # structure check (scripts/check_structure.py): function extents
   universal-ctags
   # fuzz targets (scripts/fuzz.sh, the `fuzz` preset): clang 14 and its runtime

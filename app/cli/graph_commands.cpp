@@ -11,6 +11,7 @@
 #include <set>
 
 #include "app/cli/cli.hpp"
+#include "app/cli/key_pose_commands.hpp"
 #include "app/io/log.hpp"
 #include "app/config/config.hpp"
 #include "app/graph/default_graph.hpp"
@@ -42,6 +43,8 @@ struct GraphBuildCommandOptions {
     bool json = false;
     bool keep_skeleton = false;  // --keep-skeleton: no retargeting onto the puppet
     bool default_graph = false;  // --default: the embedded default graph (app/graph/default_graph.hpp)
+    bool key_poses = false;      // --key-poses: a key-pose graph (app/cli/key_pose_commands.hpp)
+    KeyPoseBuildOptions key_pose;
 };
 
 struct GraphInfoOptions {
@@ -221,6 +224,17 @@ int graph_default_build_command(const GraphBuildCommandOptions& o) {
 
 int graph_build_command(const GraphBuildCommandOptions& o) {
     if (o.default_graph) return graph_default_build_command(o);
+    if (o.key_poses || !o.key_pose.from_xml.empty()) {
+        KeyPoseBuildOptions k = o.key_pose;
+        k.asf_file = o.asf_file;
+        k.clip_files = o.clip_files;
+        k.labels_file = o.labels_file;
+        k.config_file = o.config_file;
+        k.output_file = o.output_file;
+        k.keep_skeleton = o.keep_skeleton;
+        k.json = o.json;
+        return key_pose_build_command(k);
+    }
     if (o.clip_files.empty())
         throw ImportError("command line", 0, "graph build needs CLIPS (.bvh, or .amc with --asf), or --default");
     const AppConfig app_config = load_config(o.config_file);
@@ -326,6 +340,8 @@ int graph_info_command(const GraphInfoOptions& o) {
 }
 
 int graph_path_command(const GraphPathOptions& o) {
+    if (is_key_pose_graph_file(o.graph_file))
+        return key_pose_path_command({o.graph_file, o.from, o.to, o.bvh_file, o.json});
     const SimConfig config = load_config(o.config_file).sim;
     const MotionGraph g = load_motion_graph_file(o.graph_file);
     const auto [from_clip, from_frame] = parse_clip_frame(g, o.from, "--from");
@@ -444,6 +460,18 @@ void register_graph_commands(CLI::App& app, int& exit_code) {
     build->add_option("--dot", b->dot_file, "write the pruned graph for Graphviz");
     build->add_option("--threads", b->threads, "worker threads (0: all cores)")->check(CLI::Range(0, 256));
     build->add_flag("--json", b->json, "print a JSON summary");
+    build->add_flag("--key-poses", b->key_poses,
+                    "build a key-pose graph (speed minima, thinned, linked by pose difference), written as XML");
+    build->add_option("--from-xml", b->key_pose.from_xml, "read a key-pose graph from XML (and write it to -o)")
+        ->check(CLI::ExistingFile);
+    build->add_option("--thin", b->key_pose.thin, "key poses: no two closer than this pose difference (leg lengths²; 0: percentile)")
+        ->check(CLI::Range(0.0, 1e9));
+    build->add_option("--link", b->key_pose.link, "key poses: link poses closer than this (leg lengths²; 0: percentile)")
+        ->check(CLI::Range(0.0, 1e9));
+    build->add_option("--thin-percentile", b->key_pose.thin_percentile, "key poses: --thin as this percentile of minima pairs")
+        ->check(CLI::Range(0.0, 100.0));
+    build->add_option("--link-percentile", b->key_pose.link_percentile, "key poses: --link as this percentile of minima pairs")
+        ->check(CLI::Range(0.0, 100.0));
     on_parsed(build, exit_code, [b] { return graph_build_command(*b); });
 
     auto i = std::make_shared<GraphInfoOptions>();
@@ -455,12 +483,18 @@ void register_graph_commands(CLI::App& app, int& exit_code) {
     auto p = std::make_shared<GraphPathOptions>();
     CLI::App* path = graph->add_subcommand("path", "Cheapest path from a clip frame to a label or clip frame");
     path->add_option("graph", p->graph_file, ".mgraph file")->required();
-    path->add_option("--from", p->from, "CLIP:FRAME (0-based frame at the graph's rate)")->required();
-    path->add_option("--to", p->to, "LABEL or CLIP:FRAME")->required();
+    path->add_option("--from", p->from, "CLIP:FRAME (0-based frame at the graph's rate); on a key-pose graph a pose id or CLIP:FRAME")->required();
+    path->add_option("--to", p->to, "LABEL or CLIP:FRAME; on a key-pose graph a pose id or CLIP:FRAME")->required();
     path->add_option("--bvh", p->bvh_file, "write the synthesised motion along the path as BVH");
     path->add_option("--config", p->config_file, "TOML file overriding the defaults")->check(CLI::ExistingFile);
     path->add_flag("--json", p->json, "print JSON");
     on_parsed(path, exit_code, [p] { return graph_path_command(*p); });
+
+    auto x = std::make_shared<std::pair<std::string, std::string>>();
+    CLI::App* xport = graph->add_subcommand("export", "Write a key-pose graph as XML");
+    xport->add_option("graph", x->first, "key-pose graph file")->required()->check(CLI::ExistingFile);
+    xport->add_option("--xml", x->second, "the XML file to write")->required();
+    on_parsed(xport, exit_code, [x] { return key_pose_export_command(x->first, x->second); });
 }
 
 }  // namespace marionette
