@@ -24,15 +24,8 @@ double gamma(double n) { return n * kUnitRoundoff / (1.0 - n * kUnitRoundoff); }
 //   Pd = k·Rx2 ≥ Σ|xz_a·xz_b| over the window, Py = k·Ry2, Pc = k·C2, Q = W·Pc
 //   Mdot = Pd + 2Q ≥ |dot|, |cross| (and their parts); Mr = √2·Mdot ≥ √(dot² + cross²)
 //   Md = 2·Smax + 2·Py + 2·Mr ≥ the sum of |terms| of D = S_A + S_B − 2Y − 2√(dot² + cross²)
-// Tiled search (transition_search.cpp's fill_region):
-//   the dot and cross products come from Gauss's three dgemm products of width J,
-//   P1 = d_a·x_b, P2 = x_a·d_b, P3 = z_a·e_b with d = fl(x − z), e = fl(x + z) (features,
-//   rounded once: |d − (x − z)| ≤ u|x − z|), as dot = fl(P1 + P3), cross = fl(P1 − P2).
-//   |x − z|, |x + z| ≤ √2·|xz| per frame, so each exact product's terms sum to
-//   Σ|d_a||x_b| ≤ (1 + u)·√2·Rx2, and a dgemm product is off by
-//   eP = γ_J·(1 + u)·√2·Rx2 (any order, fused or not) + u·√2·Rx2 (the operand's rounding);
-//   dot and cross are then off by ≤ 2·eP + u·(Rx2 + 2·eP) (|exact dot|, |cross| ≤ Rx2);
-//   the height products by γ_J·Ry2 (one dgemm of y);
+// Tiled search (transition_search.cpp's run_tile):
+//   a dgemm product is off by ≤ γ_{2J}·Rx2 (γ_J·Ry2 for y);
 //   a window sum is its k products' sum (the sliding telescopes: the product that
 //   leaves is the same double that entered) plus the additions' roundings: k − 1 in
 //   the direct first row (≤ γ_k·Pd) and two per slide on values ≤ (k + 2)·Rx2;
@@ -64,8 +57,7 @@ DistanceErrorBound window_distance_error_bound(const FrameFeatures& f, std::int3
     const double slack = 1.01;  // magnitudes grown by their own (tiny) errors
 
     DistanceErrorBound b;
-    const double e_gauss = (gamma(dj) * (1.0 + u) + u) * std::sqrt(2.0) * rx2;
-    b.product_xz = slack * (2.0 * e_gauss + u * (rx2 + 2.0 * e_gauss));
+    b.product_xz = gamma(2.0 * dj) * rx2;
     b.product_y = gamma(dj) * ry2;
     // Tiled.
     const double t_sd = slack * (k * b.product_xz + gamma(k) * pd + m * 2.0 * u * (k + 2.0) * rx2);

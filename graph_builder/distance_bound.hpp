@@ -15,9 +15,8 @@ struct DistanceErrorBound {
     // |v_tiled − v_fixed| ≤ distance for every valid pair, v being the normalised
     // distance before the noise floor and the rounding to float (both monotone).
     double distance = 0.0;
-    // What the derivation allows one product to be off by: a dot or cross term made from
-    // Gauss's three dgemm products, ~(2√2·γ_J + 4u)·max|xz|², and a height product,
-    // γ_J·max|y|².
+    // What the derivation allows one dgemm product to be off by: γ_{2J}·max|xz|²
+    // (the dot and cross products) and γ_J·max|y|² (the height products).
     double product_xz = 0.0;
     double product_y = 0.0;
 };

@@ -112,8 +112,6 @@ FrameFeatures compute_frame_features(const ClipDatabase& db, std::span<const vec
     f.xz.resize(n * width);
     f.zx.resize(n * width);
     f.y.resize(n * J);
-    f.x_minus_z.resize(n * J);
-    f.x_plus_z.resize(n * J);
     f.cx.resize(n);
     f.cz.resize(n);
     std::vector<double> spread(n);
@@ -139,8 +137,6 @@ FrameFeatures compute_frame_features(const ClipDatabase& db, std::span<const vec
             f.zx[fr * width + j] = qz;
             f.zx[fr * width + J + j] = -qx;
             f.y[fr * J + j] = qy;
-            f.x_minus_z[fr * J + j] = qx - qz;
-            f.x_plus_z[fr * J + j] = qx + qz;
             s += qx * qx + qz * qz + qy * qy;
         }
         spread[fr] = s;
@@ -284,13 +280,12 @@ std::vector<double> distance_percentiles(const FrameFeatures& f, const std::vect
 namespace {
 
 // out[r][c] = row (a_first + r) of `a` · row (b_first + c) of `b`, r < a_rows,
-// c < b_rows, `width` doubles of rows lda and ldb doubles apart: every cross term of a
-// tile is one dgemm.
-void row_dots(const double* a, int lda, std::int32_t a_first, std::int32_t a_rows, const double* b, int ldb,
-              std::int32_t b_first, std::int32_t b_rows, int width, double* out) {
+// c < b_rows, rows `width` floats long: every cross term of a tile is one sgemm.
+void row_dots(const double* a, std::int32_t a_first, std::int32_t a_rows, const double* b, std::int32_t b_first,
+              std::int32_t b_rows, int width, double* out) {
     cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasTrans, a_rows, b_rows, width, 1.0,
-                a + static_cast<size_t>(a_first) * static_cast<size_t>(lda), lda,
-                b + static_cast<size_t>(b_first) * static_cast<size_t>(ldb), ldb, 0.0, out, b_rows);
+                a + static_cast<size_t>(a_first) * static_cast<size_t>(width), width,
+                b + static_cast<size_t>(b_first) * static_cast<size_t>(width), width, 0.0, out, b_rows);
 }
 
 // The per-row kernels of a tile are cloned for wider vector units where the
@@ -304,17 +299,6 @@ void row_dots(const double* a, int lda, std::int32_t a_first, std::int32_t a_row
 #ifndef MARIONETTE_VECTOR_CLONES
 #define MARIONETTE_VECTOR_CLONES
 #endif
-
-// A band's Gauss products into the dot and cross terms: on entry dot = P1, cross = P2,
-// third = P3; on exit dot = P1 + P3, cross = P1 − P2 (one rounding each).
-MARIONETTE_VECTOR_CLONES void combine_gauss(double* __restrict dot, double* __restrict cross,
-                                            const double* __restrict third, size_t n) {
-    for (size_t q = 0; q < n; ++q) {
-        const double p1 = dot[q];
-        dot[q] = p1 + third[q];
-        cross[q] = p1 - cross[q];
-    }
-}
 
 // The five window sums of a tile row, in double, each [c] for pair column c:
 // dot, cross and y cross terms (from the sgemm products) and the dot and cross
@@ -429,7 +413,6 @@ struct ScratchArray {
 
 struct TileScratch {
     ScratchArray<double> ca, cb, cy;      // per-frame cross terms of the tile (dgemm)
-    ScratchArray<double> ct;              // a band's third Gauss product (P3, fill_region)
     std::vector<double> row_cx, row_cz, col_cx, col_cz;  // frame centroids of its rows and columns
     std::vector<double> sums[2];          // window sums of the previous and the current row
     std::vector<double> col_spread, col_x, col_z;  // per column's window B
@@ -684,7 +667,6 @@ void fill_region(const FrameFeatures& f, const CandidateSearchOptions& o, const 
     s.ca.ensure(static_cast<size_t>(ring) * ucols);
     s.cb.ensure(static_cast<size_t>(ring) * ucols);
     s.cy.ensure(static_cast<size_t>(ring) * ucols);
-    s.ct.ensure(static_cast<size_t>(std::min(kBand, nr)) * ucols);
     std::int32_t made = 0;  // rows [0, made) were made; the ring holds the last `ring` of them
     // Rows up to `last` (r + k − 1 for row r, which reads product rows r − 1 … r + k − 1): a band
     // starts at made ≤ last and overwrites rows up to made − ring + kBand − 1 ≤ last − k − 1 = r − 2.
@@ -692,15 +674,9 @@ void fill_region(const FrameFeatures& f, const CandidateSearchOptions& o, const 
         while (made <= last) {
             const std::int32_t slot = made % ring, rows = std::min({kBand, nr - made, ring - slot});
             const size_t at = static_cast<size_t>(slot) * ucols;
-            // Gauss's three products (3J multiply-adds, not 4J): with d = x − z and e = x + z,
-            // P1 = d_a·x_b, P2 = x_a·d_b, P3 = z_a·e_b, dot = P1 + P3 and cross = P1 − P2.
-            const double* x = f.xz.data();
-            const double* z = f.xz.data() + J;  // the z half of the xz rows
-            row_dots(f.x_minus_z.data(), J, row0 + made, rows, x, width, col0, nc, J, s.ca.data() + at);
-            row_dots(x, width, row0 + made, rows, f.x_minus_z.data(), J, col0, nc, J, s.cb.data() + at);
-            row_dots(z, width, row0 + made, rows, f.x_plus_z.data(), J, col0, nc, J, s.ct.data());
-            row_dots(f.y.data(), J, row0 + made, rows, f.y.data(), J, col0, nc, J, s.cy.data() + at);
-            combine_gauss(s.ca.data() + at, s.cb.data() + at, s.ct.data(), static_cast<size_t>(rows) * ucols);
+            row_dots(f.xz.data(), row0 + made, rows, f.xz.data(), col0, nc, width, s.ca.data() + at);
+            row_dots(f.xz.data(), row0 + made, rows, f.zx.data(), col0, nc, width, s.cb.data() + at);
+            row_dots(f.y.data(), row0 + made, rows, f.y.data(), col0, nc, J, s.cy.data() + at);
             if (o.product_noise > 0.0) {
                 perturb_products(s.ca.data() + at, row0 + made, rows, col0, nc, o.product_noise * bound.product_xz, 0);
                 perturb_products(s.cb.data() + at, row0 + made, rows, col0, nc, o.product_noise * bound.product_xz, 1);
@@ -830,7 +806,6 @@ CandidateSearchResult find_transition_candidates(const FrameFeatures& f, const C
         const size_t ring = std::min(frames, static_cast<size_t>(kBand + f.window));
         for (TileScratch& s : scratch) {
             s.ca.ensure(ring * frames), s.cb.ensure(ring * frames), s.cy.ensure(ring * frames);
-            s.ct.ensure(std::min(frames, static_cast<size_t>(kBand)) * frames);
             s.box_lo.ensure(side * side), s.box_hi.ensure(side * side);
         }
     }

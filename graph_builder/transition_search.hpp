@@ -1,7 +1,7 @@
 #pragma once
 // Finding transition candidates: Kovar's point-cloud distance between every pair
 // of k-frame windows of the database, computed tile by tile so the N×N matrix is
-// never held. Per tile, the cross terms of all frame pairs are four dgemm products
+// never held. Per tile, the cross terms of all frame pairs are three dgemm products
 // of per-frame feature rows; the k-frame window then becomes a sum sliding
 // along the tile's diagonals, and the closed-form 2D alignment turns the sums
 // into the minimal distance. Tiles carry a halo of the local-minimum
@@ -38,10 +38,6 @@ struct FrameFeatures {
     std::vector<double> xz;              // [f][2J]: √w(x − cx)…, √w(z − cz)… (c: frame centroid)
     std::vector<double> zx;              // [f][2J]: √w(z − cz)…, −√w(x − cx)…
     std::vector<double> y;               // [f][J]:  √w·y
-    // The tiled pass's operands for the dot and cross terms in Gauss's three-product
-    // form (transition_search.cpp, fill_region): x − z and x + z of the xz rows, rounded once.
-    std::vector<double> x_minus_z;       // [f][J]: √w(x − cx) − √w(z − cz)
-    std::vector<double> x_plus_z;        // [f][J]: √w(x − cx) + √w(z − cz)
     std::vector<double> cx, cz;          // weighted ground-plane centroid per frame
     std::vector<double> window_spread;   // per window start: Σ w|p − centroid|² over the window
     std::vector<double> window_cx, window_cz;  // per window start: Σ_t c over the window
