@@ -16,6 +16,7 @@
 #include <random>
 
 #include "app/graph/default_graph.hpp"
+#include "graph_builder/distance_bound.hpp"
 #include "graph_builder/graph_builder.hpp"
 #include "runtime/math/det_math.hpp"
 #include "runtime/graph/graph_controller.hpp"
@@ -323,11 +324,86 @@ void BM_ControllerCircleActionsDefault(benchmark::State& state) {
     controller_circle_actions(state, g);
 }
 
+// A study, not a speed figure (docs/motion-graph.md, "A float proposal pass, measured"):
+// what a float (sgemm) proposal pass or block culling could save, on the dense
+// fixed-order matrix of the synthetic database (range(0) frames, threshold the 5th
+// percentile, h = 4). `float_bound` is a first-order estimate of a float pass's error
+// bound (γ per product at u = 2⁻²⁴, operands' rounding, ×2), not a proof; the counters
+// `exact_<b>` count the fixed-order re-evaluations decide_cell would need with intervals
+// ±b (the 8e-12 row is today's double pass), `blocks<B>` the share of B×B blocks holding
+// a cell at most threshold + float_bound (blocks a culling pass could not skip).
+void BM_FloatProposalStudy(benchmark::State& state) {
+    const ClipDatabase db = synthetic(state.range(0));
+    const double leg = skeleton_leg_length(db.skeleton, db.left_foot);
+    const FrameFeatures f = compute_frame_features(db, database_positions(db), 10, leg);
+    const double thr = distance_percentiles(f, {5.0})[0];
+    const int N = f.frames, J = f.joints, h = 4;
+    std::vector<float> d(static_cast<size_t>(N) * static_cast<size_t>(N));
+    for (auto _ : state) {
+        for (int i = 0; i < N; ++i)
+            for (int j = 0; j < N; ++j) d[static_cast<size_t>(i) * static_cast<size_t>(N) + static_cast<size_t>(j)] = static_cast<float>(feature_pair_distance(f, i, j));
+        double rx2 = 0.0, ry2 = 0.0;
+        for (size_t fr = 0; fr < static_cast<size_t>(N); ++fr) {
+            double x = 0.0, y = 0.0;
+            for (size_t q = 0; q < 2 * static_cast<size_t>(J); ++q) x += f.xz[fr * 2 * J + q] * f.xz[fr * 2 * J + q];
+            for (size_t q = 0; q < static_cast<size_t>(J); ++q) y += f.y[fr * J + q] * f.y[fr * J + q];
+            rx2 = std::max(rx2, x), ry2 = std::max(ry2, y);
+        }
+        const double uf = 0x1p-24;
+        const double float_bound = 2.0 * (4.0 * (2 * J + 2) * uf * rx2 + 2.0 * (J + 2) * uf * ry2) / f.weight;
+        const auto at = [&](int i, int j) -> double {
+            return i < 0 || j < 0 || i >= N || j >= N ? kPairInvalid : d[static_cast<size_t>(i) * static_cast<size_t>(N) + static_cast<size_t>(j)];
+        };
+        const auto floor0 = [](double v) { return v > kDistanceNoiseFloor ? v : 0.0; };
+        for (const double b : {8e-12, float_bound}) {
+            std::int64_t exact = 0;
+            const auto lo = [&](int i, int j) { const double v = at(i, j); return v < 0.0 || v >= kPairInvalid ? v : floor0(v - b); };
+            const auto hi = [&](int i, int j) { const double v = at(i, j); return v < 0.0 || v >= kPairInvalid ? v : floor0(v + b); };
+            for (int i = 0; i < N; ++i)
+                for (int j = 0; j < N; ++j) {
+                    const double l = lo(i, j), hc = hi(i, j);
+                    if (!(l >= 0.0 && l <= thr)) continue;
+                    std::int64_t undecided = 0;
+                    bool rejected = false;
+                    for (int di = -h; di <= h && !rejected; ++di)
+                        for (int dj = -h; dj <= h; ++dj) {
+                            if (di == 0 && dj == 0) continue;
+                            if (hi(i + di, j + dj) < l) { rejected = true; break; }
+                            if (lo(i + di, j + dj) <= hc && lo(i + di, j + dj) != hi(i + di, j + dj)) ++undecided;
+                        }
+                    if (rejected) continue;
+                    exact += 1 + (at(i, j) <= thr ? undecided : 0);
+                }
+            state.counters[b == 8e-12 ? "exact_double" : "exact_float"] = static_cast<double>(exact);
+        }
+        for (const int B : {8, 16, 32, 64, 128, 512}) {
+            std::int64_t blocks = 0, needed = 0;
+            for (int bi = 0; bi < N; bi += B)
+                for (int bj = 0; bj < N; bj += B) {
+                    bool any = false, valid = false;
+                    for (int i = bi; i < std::min(N, bi + B); ++i)
+                        for (int j = bj; j < std::min(N, bj + B); ++j) {
+                            const double v = at(i, j);
+                            valid = valid || (v >= 0.0 && v < kPairInvalid);
+                            any = any || (v >= 0.0 && v <= thr + float_bound);
+                        }
+                    blocks += valid, needed += valid && any;
+                }
+            state.counters["blocks" + std::to_string(B)] = static_cast<double>(needed) / static_cast<double>(blocks);
+        }
+        state.counters["frames"] = N;
+        state.counters["threshold"] = thr;
+        state.counters["float_bound"] = float_bound;
+        state.counters["double_bound"] = window_distance_error_bound(f, 512 + 2 * h + 10).distance;
+    }
+}
+
 }  // namespace
 
 BENCHMARK(BM_ControllerCircleActionsDefault)->Arg(64)->Unit(benchmark::kMicrosecond)->Iterations(240 * 150);
 BENCHMARK(BM_ControllerCircleActionsCmu16)->Arg(64)->Unit(benchmark::kMicrosecond)->Iterations(240 * 150);
 BENCHMARK(BM_BuildCmu16)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_FloatProposalStudy)->Arg(3000)->Unit(benchmark::kSecond)->Iterations(1);  // a study: minutes
 BENCHMARK(BM_ReferenceSpeedup)->Arg(1000)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_PathQuery)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ControllerCircleCmu16)->Arg(64)->Arg(256)->Unit(benchmark::kMicrosecond)->Iterations(36000);
