@@ -485,6 +485,13 @@ constexpr float kMaxTurnPerStepDeg = 90.0f;  // most a foot turns in one swing
 constexpr float kMaxFootTurnDegS = 300.0f;   // … and on average per second of the swing
 // Radians a foot may turn in a swing landing in `seconds`.
 double max_foot_turn(float seconds) { return minf(kMaxTurnPerStepDeg, kMaxFootTurnDegS * seconds) * det::kDegToRad; }
+// Seconds a timed swing (a stop, a closing step) takes at least, so that its
+// foot turns from `from` to `to` at no more than kMaxFootTurnDegS on average:
+// held to stop_transition_s, a foot turned 100–175° in 0.15–0.3 s and the foot
+// joint passed 1500 °/s (sweep cases 1-0071, 1-0136, 7-0012, 7-0289 ...).
+float turn_time(quat from, quat to) {
+    return static_cast<float>(quat_angle_between(from, to) * det::kRadToDeg) / kMaxFootTurnDegS;
+}
 
 // Runs the tick's own steering law (steer_root: turns, braking, walls) and step
 // clock forward tick by tick from this tick's root until the foot's phase
@@ -533,6 +540,7 @@ Placement plan_target(const GaitState& g, const GaitTick& t, int foot, vec3 root
 }
 
 constexpr float kShortestSwing = 0.12f;           // s: a late lift-off still swings this long
+constexpr float kMaxMeanSwingSpeed = 4.0f;        // m/s: … and at least its travel over this
 constexpr float kWristDrag = 0.4f;                // hand tilt against its path's velocity, per m/cycle
 constexpr float kMaxPelvisVerticalSpeed = 0.9f;   // m/s the pelvis follows its height target at, at most
 
@@ -782,9 +790,11 @@ void start_stopping(GaitState& g, const GaitTick& t, vec3 root) {
         const vec3 spot = root + t.h.left * (side_sign(i) * t.rig.hip_half_width);
         const Placement p = other.swinging ? place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, t.h.forward)
                                            : stop_target(g, i, t.heading, t.rig, t.terrain);
-        // Short, but never faster than kMaxStopFootSpeed for the foot.
-        const float time = clampf(maxf(remaining, horizontal_distance(f.ankle, p.ankle) / kMaxStopFootSpeed), kMinStopSwingS,
-                                  t.c.stop_transition_s);
+        // Short, but never faster than kMaxStopFootSpeed for the foot, nor
+        // turning faster than kMaxFootTurnDegS on average.
+        const float time = maxf(clampf(maxf(remaining, horizontal_distance(f.ankle, p.ankle) / kMaxStopFootSpeed), kMinStopSwingS,
+                                       t.c.stop_transition_s),
+                                turn_time(f.rotation, p.rotation));
         begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, 0.0f, 1.0f / time);
     }
 }
@@ -814,12 +824,18 @@ Placement aim_swing(const GaitState& g, const GaitTick& t, vec3 root, int i, flo
     return place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, heading_frame(facing).forward);
 }
 
+// The shortest a phase-driven swing may take: kShortestSwing, and its travel
+// at kMaxMeanSwingSpeed. A foot lifting (or re-aimed) late in its phase had the
+// cycle's few remaining hundredths of a second for up to 0.9 m: its shin passed
+// 1500 °/s (wall × reversals after a long stop swing, 1506 °/s).
+float shortest_swing(const FootState& f, const GaitRig& rig) { return maxf(kShortestSwing, swing_travel(f, rig) / kMaxMeanSwingSpeed); }
+
 // The swing's progress per second: at its own rate after a stop, else with the
 // cycle's phase (over what was left of it at lift-off), but never slower than a
 // kShortestSwing swing.
 float swing_rate(const FootState& f, const GaitTick& t) {
     return f.timed_rate > 0.0f ? f.timed_rate
-                               : minf(t.dphase / t.dt / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), 1.0f / kShortestSwing);
+                               : minf(t.dphase / t.dt / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), 1.0f / shortest_swing(f, t.rig));
 }
 
 // Where a swing's hip will be when it lands, if the root keeps its speed and heading.
@@ -867,7 +883,7 @@ void advance_swing(GaitState& g, const GaitTick& t, vec3 root, int i) {
     FootState& f = g.feet[static_cast<std::size_t>(i)];
     const float rate = f.timed_rate > 0.0f
                            ? f.timed_rate * t.dt
-                           : minf(t.dphase / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), t.dt / kShortestSwing);
+                           : minf(t.dphase / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), t.dt / shortest_swing(f, t.rig));
     f.progress += rate;
     if (f.progress >= 1.0f) {
         land(f, g);
@@ -922,8 +938,8 @@ void finish_stopping(GaitState& g, const GaitTick& t) {
         const int trailing = along < 0.0f ? 0 : 1;
         FootState& f = g.feet[static_cast<std::size_t>(trailing)];
         const Placement p = stop_target(g, trailing, t.heading, t.rig, t.terrain);
-        begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, 0.0f,
-                    1.0f / maxf(kMinClosingStepS, t.c.stop_transition_s * kClosingStepStretch));
+        const float time = maxf(maxf(kMinClosingStepS, t.c.stop_transition_s * kClosingStepStretch), turn_time(f.rotation, p.rotation));
+        begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, 0.0f, 1.0f / time);
         evaluate_swing(f, trailing, t.c, t.rig, g.run_blend, t.h.left);
     } else {
         g.mode = GaitMode::idle;
