@@ -364,7 +364,8 @@ TEST_CASE("gait sweep regressions: the swing path clears the next tread", "[gait
 // Known failure, kept so it stays found (docs/gait.md, "After merging both
 // branches"): running up 21 cm / 28 cm stairs at 54° off their axis, the swing's
 // ankle descends between path keys while its toe is inside the next riser
-// (113 mm). Reported by the sweep; not fixed yet, so it may fail.
+// (113 mm; 153 mm since the path prediction asks the ground ahead, branch
+// gait3). Reported by the sweep; not fixed yet, so it may fail.
 TEST_CASE("gait sweep known failure: 7-0080, a toe inside a riser running up stairs at an angle",
           "[gait_sweep][!mayfail]") {
     check_sweep_regressions({{7, 80}}, false, true);
