@@ -117,19 +117,42 @@ void frame_features(const std::vector<FrameBody>& body, int begin, int end, int 
     }
 }
 
-void build_boxes(const MatchingDatabase& db, int size, std::vector<float>& lo, std::vector<float>& hi) {
-    const size_t boxes = (static_cast<size_t>(db.frame_count) + static_cast<size_t>(size) - 1) / static_cast<size_t>(size);
+// Bounds over runs of `size` frames (padded to `boxes`), stored feature-major in
+// groups of `lanes` boxes: [box / lanes][k][box % lanes].
+void build_boxes(const MatchingDatabase& db, int size, size_t boxes, size_t lanes, std::vector<float>& lo, std::vector<float>& hi) {
     lo.assign(boxes * kMatchFeatureCount, std::numeric_limits<float>::infinity());
     hi.assign(boxes * kMatchFeatureCount, -std::numeric_limits<float>::infinity());
     for (int f = 0; f < db.frame_count; ++f) {
         if (!db.searchable[static_cast<size_t>(f)]) continue;
-        const size_t box = static_cast<size_t>(f / size) * kMatchFeatureCount;
+        const size_t box = static_cast<size_t>(f / size);
+        const size_t base = (box / lanes) * lanes * kMatchFeatureCount + box % lanes;
         const float* x = db.frame_features(f);
         for (size_t k = 0; k < kMatchFeatureCount; ++k) {
-            if (x[k] < lo[box + k]) lo[box + k] = x[k];
-            if (x[k] > hi[box + k]) hi[box + k] = x[k];
+            const size_t i = base + k * lanes;
+            if (x[k] < lo[i]) lo[i] = x[k];
+            if (x[k] > hi[i]) hi[i] = x[k];
         }
     }
+}
+
+void build_search_layout(MatchingDatabase& db) {
+    const size_t frames = static_cast<size_t>(db.frame_count);
+    const size_t tops = (frames + kMatchTopBox - 1) / kMatchTopBox;
+    const size_t padded = tops * kMatchTopBox;
+    const size_t lanes = kMatchLanes;
+    db.block_features.assign(padded * kMatchFeatureCount, 0.0f);
+    db.block_searchable.assign(padded / lanes, 0);
+    for (size_t f = 0; f < frames; ++f) {
+        const size_t block = f / lanes, lane = f % lanes;
+        for (size_t k = 0; k < kMatchFeatureCount; ++k)
+            db.block_features[(block * kMatchFeatureCount + k) * lanes + lane] = db.features[f * kMatchFeatureCount + k];
+        if (db.searchable[f]) db.block_searchable[block] = static_cast<std::uint8_t>(db.block_searchable[block] | (1u << lane));
+    }
+    // Top boxes are grouped 8 to a group (rounded up), large boxes 8 to a top box, small 4 to a large box.
+    const size_t top_groups = (tops + lanes - 1) / lanes;
+    build_boxes(db, kMatchTopBox, top_groups * lanes, lanes, db.top_lo, db.top_hi);
+    build_boxes(db, kMatchLargeBox, padded / kMatchLargeBox, lanes, db.large_lo, db.large_hi);
+    build_boxes(db, kMatchSmallBox, padded / kMatchSmallBox, kMatchSmallPerLarge, db.small_lo, db.small_hi);
 }
 
 }  // namespace
@@ -160,8 +183,7 @@ void normalise_matching_database(MatchingDatabase& db, const MatchingWeights& we
     for (size_t f = 0; f < frames; ++f)
         db.normalise(std::span<const float>(db.raw_features.data() + f * kMatchFeatureCount, kMatchFeatureCount),
                      std::span<float>(db.features.data() + f * kMatchFeatureCount, kMatchFeatureCount));
-    build_boxes(db, kMatchSmallBox, db.small_lo, db.small_hi);
-    build_boxes(db, kMatchLargeBox, db.large_lo, db.large_hi);
+    build_search_layout(db);
 }
 
 Outcome build_matching_database(const MatchingSource& s, const MatchingWeights& weights, MatchingDatabase& out) {
