@@ -93,16 +93,19 @@ struct MatchingDatabase {
     std::vector<float> raw_features;             // the same before normalisation (metres, m/s, unit facings)
     std::array<float, kMatchFeatureCount> mean{};
     std::array<float, kMatchFeatureCount> inv_scale{};  // weight / group standard deviation
-    // The search's plain data, rebuilt by normalise_matching_database, padded to
-    // whole top boxes (padding frames: zero features, not searchable):
-    //   block_features [block][k][lane]: the features of frames block·8 + lane,
-    //     feature-major, so a block's 8 costs are summed lane-parallel, each lane
-    //     in feature order (the same float sums as matching_cost);
-    //   block_searchable [block]: bit `lane` set when that frame is searchable;
-    //   bounds of the searchable frames' features over runs of frames, a box with
+    // The search's plain data, rebuilt by normalise_matching_database: the
+    // searchable frames in k-d order (runs of slots close in feature space), in
+    // slots padded to whole top boxes (padding: zero features, no frame):
+    //   block_frame [slot]: the database frame in slot block·8 + lane, or −1;
+    //   block_features [block][k][lane]: those frames' features, feature-major,
+    //     so a block's 8 costs are summed lane-parallel, each lane in feature
+    //     order (the same float sums as matching_cost);
+    //   block_searchable [block]: bit `lane` set when that slot holds a frame;
+    //   bounds of the features over runs of slots, a box with
     //   none empty (lo = +inf, hi = −inf), feature-major like the blocks:
     //   top_lo/hi [group][k][lane] (top box group·8 + lane), large_lo/hi [top][k][lane]
     //   (large box top·8 + lane), small_lo/hi [large][k][s] (small box large·4 + s).
+    std::vector<std::int32_t> block_frame;
     std::vector<float> block_features;
     std::vector<std::uint8_t> block_searchable;
     std::vector<float> top_lo, top_hi, large_lo, large_hi, small_lo, small_hi;

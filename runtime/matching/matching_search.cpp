@@ -1,5 +1,6 @@
 #include "runtime/matching/matching_search.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <cstring>
@@ -44,26 +45,56 @@ F4 select(I4 mask, F4 a, F4 b) {
 }
 
 // Squared distances from the query to L boxes stored feature-major ([k][lane]),
-// each lane summed in feature order: each term is at most the same term for any
-// frame inside, so (float addition being monotonic) a box's cost never exceeds
-// its frames' costs; an empty box (lo = +inf, hi = −inf) costs infinity.
-template <size_t L>
-std::array<float, L> box_costs(const float* lo, const float* hi, const float* q) {
-    constexpr size_t V = L / 4;
+// each lane summed over features [Begin, kMatchFeatureCount) in feature order.
+// Each term is at most the same term for any frame inside, and float addition is
+// monotonic and never decreases a sum by a non-negative term, so such a sum
+// (the whole of it, or only the later features, the trajectory, which tell clips
+// apart the most) never exceeds a frame's matching_cost: a box whose sum is
+// strictly worse than the best holds no frame that could win or tie. An empty
+// box (lo = +inf, hi = −inf) costs infinity.
+constexpr size_t kTrajectoryBegin = static_cast<size_t>(kMatchGroupBegin[kMatchTrajectoryPosition]);
+
+F4 box_term(const float* lo, const float* hi, F4 qk) {
     const F4 zero{};
-    std::array<F4, V> cost{};
-    for (size_t k = 0; k < kMatchFeatureCount; ++k) {
+    const F4 below = load(lo) - qk;
+    const F4 above = qk - load(hi);
+    const F4 d = select(below > 0.0f, below, select(above > 0.0f, above, zero));
+    return d * d;
+}
+
+template <size_t L, size_t Begin = 0>
+std::array<float, L> box_costs(const float* lo, const float* hi, const float* q) {
+    static_assert(L == 4 || L == 8);
+    const F4 zero{};
+    F4 c0{}, c1{};
+    for (size_t k = Begin; k < kMatchFeatureCount; ++k) {
         const F4 qk = zero + q[k];
-        for (size_t v = 0; v < V; ++v) {
-            const F4 below = load(lo + k * L + 4 * v) - qk;
-            const F4 above = qk - load(hi + k * L + 4 * v);
-            const F4 d = select(below > 0.0f, below, select(above > 0.0f, above, zero));
-            cost[v] += d * d;
-        }
+        c0 += box_term(lo + k * L, hi + k * L, qk);
+        if constexpr (L == 8) c1 += box_term(lo + k * L + 4, hi + k * L + 4, qk);
     }
     std::array<float, L> out;
-    std::memcpy(out.data(), cost.data(), sizeof out);
+    std::memcpy(out.data(), &c0, sizeof c0);
+    if constexpr (L == 8) std::memcpy(out.data() + 4, &c1, sizeof c1);
     return out;
+}
+
+template <size_t N>
+bool all_worse(const std::array<float, N>& c, float bound) {
+    bool all = true;
+    for (float x : c) all = all && x > bound;
+    return all;
+}
+
+// Lanes 0..N−1 by increasing cost (insertion sort; any order is exact, nearer first prunes more).
+template <size_t N>
+std::array<std::uint8_t, N> by_cost(const std::array<float, N>& c) {
+    std::array<std::uint8_t, N> order;
+    for (size_t i = 0; i < N; ++i) {
+        size_t j = i;
+        for (; j > 0 && c[i] < c[order[j - 1]]; --j) order[j] = order[j - 1];
+        order[j] = static_cast<std::uint8_t>(i);
+    }
+    return order;
 }
 
 struct Search {
@@ -93,14 +124,17 @@ struct Search {
         std::memcpy(cost.data(), &c0, sizeof c0);
         std::memcpy(cost.data() + 4, &c1, sizeof c1);
         for (int lane = 0; lane < kMatchLanes; ++lane) {
-            const std::int32_t f = static_cast<std::int32_t>(b * kMatchLanes) + lane;
+            const std::int32_t f = db.block_frame[b * kMatchLanes + static_cast<size_t>(lane)];
             if ((mask >> lane) & 1u && best.beaten_by(cost[static_cast<size_t>(lane)], f)) best = {f, cost[static_cast<size_t>(lane)]};
         }
     }
     void large(size_t l) {
         const size_t stride = kMatchFeatureCount * kMatchSmallPerLarge;
-        const auto c = box_costs<kMatchSmallPerLarge>(db.small_lo.data() + l * stride, db.small_hi.data() + l * stride, q);
-        for (size_t s = 0; s < kMatchSmallPerLarge; ++s) {
+        const float* lo = db.small_lo.data() + l * stride;
+        const float* hi = db.small_hi.data() + l * stride;
+        if (all_worse(box_costs<kMatchSmallPerLarge, kTrajectoryBegin>(lo, hi, q), best.cost)) return;
+        const auto c = box_costs<kMatchSmallPerLarge>(lo, hi, q);
+        for (const std::uint8_t s : by_cost(c)) {
             if (c[s] > best.cost) continue;  // strictly worse: a tie still reaches its frames
             const size_t first = (l * kMatchSmallPerLarge + s) * (kMatchSmallBox / kMatchLanes);
             for (size_t b = first; b < first + kMatchSmallBox / kMatchLanes; ++b) block(b);
@@ -108,8 +142,10 @@ struct Search {
     }
     void top(size_t t) {
         const size_t stride = kMatchFeatureCount * kMatchLanes;
-        const auto c = box_costs<kMatchLanes>(db.large_lo.data() + t * stride, db.large_hi.data() + t * stride, q);
-        for (size_t lane = 0; lane < kMatchLanes; ++lane)
+        const float* lo = db.large_lo.data() + t * stride;
+        const float* hi = db.large_hi.data() + t * stride;
+        const auto c = box_costs<kMatchLanes>(lo, hi, q);
+        for (const std::uint8_t lane : by_cost(c))
             if (!(c[lane] > best.cost)) large(t * kMatchLanes + lane);
     }
     std::array<float, kMatchLanes> top_costs(size_t group) const {
@@ -122,26 +158,32 @@ struct Search {
 
 MatchingResult search_matching_accelerated(const MatchingDatabase& db, std::span<const float> query, MatchingResult best) {
     Search s{db, query.data(), best};
-    const size_t groups = db.top_lo.size() / (kMatchFeatureCount * kMatchLanes);
     const size_t tops = db.block_features.size() / (static_cast<size_t>(kMatchFeatureCount) * kMatchTopBox);  // the rest pad the last group
-    // First the top box nearest the query, for a tight best early; then every
-    // other top box in order. The answer is the least (cost, frame) over all
-    // searchable frames whatever the visiting order, as a box is skipped only
-    // when strictly worse than a cost already found.
-    size_t nearest = SIZE_MAX;
-    float nearest_cost = std::numeric_limits<float>::infinity();
-    for (size_t g = 0; g < groups; ++g) {
-        const auto c = s.top_costs(g);
-        for (size_t lane = 0; lane < kMatchLanes; ++lane)
-            if (g * kMatchLanes + lane < tops && c[lane] < nearest_cost) nearest_cost = c[lane], nearest = g * kMatchLanes + lane;
-    }
-    if (nearest != SIZE_MAX && !(nearest_cost > s.best.cost)) s.top(nearest);
-    for (size_t g = 0; g < groups; ++g) {
-        const auto c = s.top_costs(g);
-        for (size_t lane = 0; lane < kMatchLanes; ++lane) {
-            const size_t t = g * kMatchLanes + lane;
-            if (t < tops && t != nearest && !(c[lane] > s.best.cost)) s.top(t);
+    // Top boxes a chunk at a time (costs on the stack): the few nearest the query
+    // first, for a tight best early, then the others in order. The answer is the
+    // least (cost, frame) over all searchable frames whatever the visiting order,
+    // as a box is skipped only when strictly worse than a cost already found.
+    constexpr size_t kChunk = 256;      // top boxes per chunk (131,072 frames)
+    constexpr int kNearestFirst = 4;
+    std::array<float, kChunk> cost;
+    std::array<bool, kChunk> done;
+    for (size_t first = 0; first < tops; first += kChunk) {
+        const size_t n = tops - first < kChunk ? tops - first : kChunk;
+        for (size_t g = 0; g * kMatchLanes < n; ++g) {
+            const auto c = s.top_costs(first / kMatchLanes + g);
+            std::memcpy(cost.data() + g * kMatchLanes, c.data(), sizeof c);
         }
+        std::fill(done.begin(), done.begin() + static_cast<std::ptrdiff_t>(n), false);
+        for (int pass = 0; pass < kNearestFirst; ++pass) {
+            size_t nearest = n;
+            for (size_t i = 0; i < n; ++i)
+                if (!done[i] && (nearest == n || cost[i] < cost[nearest])) nearest = i;
+            if (nearest == n || cost[nearest] > s.best.cost) break;
+            done[nearest] = true;
+            s.top(first + nearest);
+        }
+        for (size_t i = 0; i < n; ++i)
+            if (!done[i] && !(cost[i] > s.best.cost)) s.top(first + i);
     }
     return s.best;
 }

@@ -167,6 +167,11 @@ TEST_CASE("matching search: accelerated equals brute force across the envelope o
     std::uint64_t rng = 77;
     int queries = 0, exact_ties = 0, infinite = 0;
     for (const MatchingDatabase& db : envelope_databases()) {
+        // The search layout holds every searchable frame exactly once.
+        std::vector<int> seen(static_cast<size_t>(db.frame_count), 0);
+        for (std::int32_t f : db.block_frame)
+            if (f >= 0) ++seen[static_cast<size_t>(f)];
+        for (int f = 0; f < db.frame_count; ++f) REQUIRE(seen[static_cast<size_t>(f)] == db.searchable[static_cast<size_t>(f)]);
         for (int q = 0; q < 400; ++q, ++queries) {
             std::array<float, kMatchFeatureCount> query{};
             const int kind = q % 8;
