@@ -4,6 +4,9 @@
 #include <array>
 #include <cstdint>
 #include <cstring>
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
 
 namespace marionette {
 
@@ -40,9 +43,11 @@ F4 load(const float* p) {
     std::memcpy(&v, p, sizeof v);
     return v;
 }
+#if !defined(__SSE__)
 F4 select(I4 mask, F4 a, F4 b) {
     return reinterpret_cast<F4>((mask & reinterpret_cast<I4>(a)) | (~mask & reinterpret_cast<I4>(b)));
 }
+#endif
 
 // Squared distances from the query to L boxes stored feature-major ([k][lane]),
 // each lane summed over features [Begin, kMatchFeatureCount) in feature order.
@@ -54,11 +59,21 @@ F4 select(I4 mask, F4 a, F4 b) {
 // box (lo = +inf, hi = −inf) costs infinity.
 constexpr size_t kTrajectoryBegin = static_cast<size_t>(kMatchGroupBegin[kMatchTrajectoryPosition]);
 
+// One feature's term for 4 boxes: the square of how far the query is below lo or
+// above hi (0 inside). For finite bounds with lo ≤ hi this is max(below, above,
+// 0) exactly; either form is at most the term of any frame inside, which is all
+// the search needs (an empty box may read 0 instead of +inf when the query is
+// infinite: a weaker bound, still a bound; a NaN query reads 0, as the frames'
+// NaN costs never win anyway).
 F4 box_term(const float* lo, const float* hi, F4 qk) {
-    const F4 zero{};
     const F4 below = load(lo) - qk;
     const F4 above = qk - load(hi);
+#if defined(__SSE__)
+    const F4 d = _mm_max_ps(_mm_max_ps(below, above), F4{});
+#else
+    const F4 zero{};
     const F4 d = select(below > 0.0f, below, select(above > 0.0f, above, zero));
+#endif
     return d * d;
 }
 
