@@ -56,7 +56,7 @@ F4 select(I4 mask, F4 a, F4 b) {
 // (the whole of it, or only the later features, the trajectory, which tell clips
 // apart the most) never exceeds a frame's matching_cost: a box whose sum is
 // strictly worse than the best holds no frame that could win or tie. An empty
-// box (lo = +inf, hi = −inf) costs infinity.
+// box (lo = +inf, hi = −inf) costs infinity for a finite query.
 constexpr size_t kTrajectoryBegin = static_cast<size_t>(kMatchGroupBegin[kMatchTrajectoryPosition]);
 
 // One feature's term for 4 boxes: the square of how far the query is below lo or
