@@ -1,5 +1,6 @@
 #include "runtime/matching/matching_database.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -117,19 +118,75 @@ void frame_features(const std::vector<FrameBody>& body, int begin, int end, int 
     }
 }
 
-void build_boxes(const MatchingDatabase& db, int size, std::vector<float>& lo, std::vector<float>& hi) {
-    const size_t boxes = (static_cast<size_t>(db.frame_count) + static_cast<size_t>(size) - 1) / static_cast<size_t>(size);
+// Bounds over runs of `size` slots of the layout (padded to `boxes`), stored
+// feature-major in groups of `lanes` boxes: [box / lanes][k][box % lanes].
+void build_boxes(const MatchingDatabase& db, int size, size_t boxes, size_t lanes, std::vector<float>& lo, std::vector<float>& hi) {
     lo.assign(boxes * kMatchFeatureCount, std::numeric_limits<float>::infinity());
     hi.assign(boxes * kMatchFeatureCount, -std::numeric_limits<float>::infinity());
-    for (int f = 0; f < db.frame_count; ++f) {
-        if (!db.searchable[static_cast<size_t>(f)]) continue;
-        const size_t box = static_cast<size_t>(f / size) * kMatchFeatureCount;
-        const float* x = db.frame_features(f);
+    for (size_t slot = 0; slot < db.block_frame.size(); ++slot) {
+        if (db.block_frame[slot] < 0) continue;
+        const size_t box = slot / static_cast<size_t>(size);
+        const size_t base = (box / lanes) * lanes * kMatchFeatureCount + box % lanes;
+        const float* x = db.frame_features(db.block_frame[slot]);
         for (size_t k = 0; k < kMatchFeatureCount; ++k) {
-            if (x[k] < lo[box + k]) lo[box + k] = x[k];
-            if (x[k] > hi[box + k]) hi[box + k] = x[k];
+            const size_t i = base + k * lanes;
+            if (x[k] < lo[i]) lo[i] = x[k];
+            if (x[k] > hi[i]) hi[i] = x[k];
         }
     }
+}
+
+// Orders frames so that runs of the layout are close in feature space (a k-d
+// split: the feature of widest spread, halves at multiples of a small box), which
+// keeps the boxes tight. Only speed depends on it: the search's answer is the
+// least (cost, frame index) whatever the order. Deterministic: ties in a feature
+// go by frame index.
+void kd_order(const MatchingDatabase& db, std::int32_t* begin, std::int32_t* end) {
+    const std::ptrdiff_t n = end - begin;
+    if (n <= kMatchSmallBox) return;
+    size_t widest = 0;
+    float spread = -1.0f;
+    for (size_t k = 0; k < kMatchFeatureCount; ++k) {
+        float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+        for (const std::int32_t* f = begin; f != end; ++f) {
+            const float x = db.frame_features(*f)[k];
+            lo = x < lo ? x : lo;
+            hi = x > hi ? x : hi;
+        }
+        if (hi - lo > spread) spread = hi - lo, widest = k;
+    }
+    const std::ptrdiff_t half = ((n + 1) / 2 + kMatchSmallBox - 1) / kMatchSmallBox * kMatchSmallBox;
+    std::nth_element(begin, begin + half, end, [&](std::int32_t a, std::int32_t b) {
+        const float xa = db.frame_features(a)[widest], xb = db.frame_features(b)[widest];
+        return xa < xb || (xa == xb && a < b);
+    });
+    kd_order(db, begin, begin + half);
+    kd_order(db, begin + half, end);
+}
+
+void build_search_layout(MatchingDatabase& db) {
+    std::vector<std::int32_t> order;
+    for (std::int32_t f = 0; f < db.frame_count; ++f)
+        if (db.searchable[static_cast<size_t>(f)]) order.push_back(f);
+    kd_order(db, order.data(), order.data() + order.size());
+    const size_t tops = (order.size() + kMatchTopBox - 1) / kMatchTopBox;
+    const size_t padded = tops * kMatchTopBox;
+    const size_t lanes = kMatchLanes;
+    db.block_features.assign(padded * kMatchFeatureCount, 0.0f);
+    db.block_frame.assign(padded, -1);
+    db.block_searchable.assign(padded / lanes, 0);
+    for (size_t slot = 0; slot < order.size(); ++slot) {
+        const size_t block = slot / lanes, lane = slot % lanes;
+        const float* x = db.frame_features(order[slot]);
+        for (size_t k = 0; k < kMatchFeatureCount; ++k) db.block_features[(block * kMatchFeatureCount + k) * lanes + lane] = x[k];
+        db.block_frame[slot] = order[slot];
+        db.block_searchable[block] = static_cast<std::uint8_t>(db.block_searchable[block] | (1u << lane));
+    }
+    // Top boxes are grouped 8 to a group (rounded up), large boxes 8 to a top box, small 4 to a large box.
+    const size_t top_groups = (tops + lanes - 1) / lanes;
+    build_boxes(db, kMatchTopBox, top_groups * lanes, lanes, db.top_lo, db.top_hi);
+    build_boxes(db, kMatchLargeBox, padded / kMatchLargeBox, lanes, db.large_lo, db.large_hi);
+    build_boxes(db, kMatchSmallBox, padded / kMatchSmallBox, kMatchSmallPerLarge, db.small_lo, db.small_hi);
 }
 
 }  // namespace
@@ -160,8 +217,7 @@ void normalise_matching_database(MatchingDatabase& db, const MatchingWeights& we
     for (size_t f = 0; f < frames; ++f)
         db.normalise(std::span<const float>(db.raw_features.data() + f * kMatchFeatureCount, kMatchFeatureCount),
                      std::span<float>(db.features.data() + f * kMatchFeatureCount, kMatchFeatureCount));
-    build_boxes(db, kMatchSmallBox, db.small_lo, db.small_hi);
-    build_boxes(db, kMatchLargeBox, db.large_lo, db.large_hi);
+    build_search_layout(db);
 }
 
 Outcome build_matching_database(const MatchingSource& s, const MatchingWeights& weights, MatchingDatabase& out) {

@@ -29,8 +29,14 @@ namespace marionette {
 
 inline constexpr int kMatchFeatureCount = 27;
 inline constexpr int kMatchTrajectoryPoints = 3;           // at 1/3, 2/3 and 1 s
-inline constexpr int kMatchSmallBox = 16;                 // frames per small bounding box
-inline constexpr int kMatchLargeBox = 64;                 // frames per large bounding box (4 small)
+// The search's layout (matching_search.cpp): blocks of kMatchLanes frames summed
+// lane-parallel, small boxes of 2 blocks, large boxes of 4 small, top boxes of
+// kMatchLanes large ones.
+inline constexpr int kMatchLanes = 8;                      // frames per block, large boxes per top box
+inline constexpr int kMatchSmallBox = 16;                  // frames per small bounding box (2 blocks)
+inline constexpr int kMatchLargeBox = 64;                  // frames per large bounding box (4 small)
+inline constexpr int kMatchTopBox = 512;                   // frames per top bounding box (8 large)
+inline constexpr int kMatchSmallPerLarge = kMatchLargeBox / kMatchSmallBox;
 
 // Feature groups: [begin, end) in the feature vector.
 enum MatchFeatureGroup : int {
@@ -87,9 +93,22 @@ struct MatchingDatabase {
     std::vector<float> raw_features;             // the same before normalisation (metres, m/s, unit facings)
     std::array<float, kMatchFeatureCount> mean{};
     std::array<float, kMatchFeatureCount> inv_scale{};  // weight / group standard deviation
-    // Bounds of the searchable frames' features over runs of frames: box b covers
-    // frames [b·size, (b+1)·size); a box with no searchable frame is empty (lo > hi).
-    std::vector<float> small_lo, small_hi, large_lo, large_hi;  // [box * kMatchFeatureCount + k]
+    // The search's plain data, rebuilt by normalise_matching_database: the
+    // searchable frames in k-d order (runs of slots close in feature space), in
+    // slots padded to whole top boxes (padding: zero features, no frame):
+    //   block_frame [slot]: the database frame in slot block·8 + lane, or −1;
+    //   block_features [block][k][lane]: those frames' features, feature-major,
+    //     so a block's 8 costs are summed lane-parallel, each lane in feature
+    //     order (the same float sums as matching_cost);
+    //   block_searchable [block]: bit `lane` set when that slot holds a frame;
+    //   bounds of the features over runs of slots, a box with
+    //   none empty (lo = +inf, hi = −inf), feature-major like the blocks:
+    //   top_lo/hi [group][k][lane] (top box group·8 + lane), large_lo/hi [top][k][lane]
+    //   (large box top·8 + lane), small_lo/hi [large][k][s] (small box large·4 + s).
+    std::vector<std::int32_t> block_frame;
+    std::vector<float> block_features;
+    std::vector<std::uint8_t> block_searchable;
+    std::vector<float> top_lo, top_hi, large_lo, large_hi, small_lo, small_hi;
 
     const float* frame_features(int frame) const { return features.data() + static_cast<size_t>(frame) * kMatchFeatureCount; }
     const float* frame_raw(int frame) const { return raw_features.data() + static_cast<size_t>(frame) * kMatchFeatureCount; }

@@ -6,14 +6,17 @@
 // frames are visited in.
 //
 // search_matching_brute_force visits every frame. search_matching_accelerated
-// gives exactly the same answer faster: it skips a run of frames when the
-// distance from the query to the run's bounding box (large boxes of
-// kMatchLargeBox frames, then small ones of kMatchSmallBox) already exceeds the
-// best cost, and stops summing a frame's distance once it does (Holden's
-// Motion-Matching code does the same). Both are exact: a box's distance is a
-// float sum of terms no larger than any of its frames' terms, in the same order,
-// so it never exceeds their costs, and a box is skipped only when it is
-// strictly worse, so a tie still reaches the frame comparison. Neither allocates.
+// gives exactly the same answer faster, on the database's search layout (plain
+// data built with it, matching_database.hpp): the searchable frames in k-d order
+// under three levels of bounding boxes (512, 64 and 16 frames), 8 frames summed
+// lane-parallel. It visits the top boxes nearest the query first, then the rest,
+// and skips a box when a lower bound of its frames' costs is strictly worse than
+// the best so far; a block of 8 frames is abandoned once all of them are. Every
+// bound is a float sum, in feature order, of terms no larger than the frames'
+// (all the features, or only the trajectory's), so it never exceeds a frame's
+// cost; each frame's cost is the same float sum as matching_cost, bit for bit;
+// so the result is the least (cost, frame index) whatever the visiting order,
+// ties to the lower frame. Neither search allocates.
 #include <cstdint>
 #include <limits>
 #include <span>

@@ -4,6 +4,8 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstring>
+#include <vector>
 
 #include "runtime/matching/matching_search.hpp"
 #include "tests/runtime/matching/matching_fixture.hpp"
@@ -126,4 +128,91 @@ TEST_CASE("matching search: equal costs go to the lower frame in both searches",
         CHECK(search_matching_brute_force(db, query, start).frame == original);
         CHECK(search_matching_accelerated(db, query, start).frame == original);
     }
+}
+
+namespace {
+// Bit pattern of a cost: the searches must agree to the last bit.
+std::uint32_t bits(float c) {
+    std::uint32_t u = 0;
+    std::memcpy(&u, &c, sizeof u);
+    return u;
+}
+
+// The envelope's databases: sizes that are not whole boxes (padding), a constant
+// (zero-weight) group, duplicated clips (exact ties between frames), and raw
+// features snapped to a coarse grid (many equal frames, flat boxes).
+std::vector<MatchingDatabase> envelope_databases() {
+    std::vector<MatchingDatabase> dbs;
+    dbs.push_back(build(test::make_matching_fixture(7, 73, 3)));
+    MatchingWeights still;
+    still.hips_velocity = 0.0f;
+    dbs.push_back(build(test::make_matching_fixture(30, 200, 9), still));
+    test::MatchingFixture twice = test::make_matching_fixture(9, 90, 21);
+    for (int c = 0; c < 9; ++c) twice.clips.push_back(twice.clips[static_cast<size_t>(c)]);
+    dbs.push_back(build(twice));
+    MatchingDatabase grid = build(test::make_matching_fixture(10, 100, 4));
+    for (float& x : grid.raw_features) x = std::round(x * 4.0f) / 4.0f;
+    normalise_matching_database(grid, {});
+    dbs.push_back(grid);
+    return dbs;
+}
+}  // namespace
+
+TEST_CASE("matching search: accelerated equals brute force across the envelope of queries", "[matching]") {
+    // Fixed seed. Per database 400 queries: the whole range, far outside the data
+    // (up to 1e6, and 1e20 whose squares overflow to infinite costs, all tied), exact
+    // frames (zero cost, ties across duplicated clips), near frames, degenerate
+    // queries (all zero, one feature set) and a NaN feature (no frame can win); each
+    // with no candidate, the current frame, or a candidate tying the answer's cost.
+    std::uint64_t rng = 77;
+    int queries = 0, exact_ties = 0, infinite = 0;
+    for (const MatchingDatabase& db : envelope_databases()) {
+        // The search layout holds every searchable frame exactly once.
+        std::vector<int> seen(static_cast<size_t>(db.frame_count), 0);
+        for (std::int32_t f : db.block_frame)
+            if (f >= 0) ++seen[static_cast<size_t>(f)];
+        for (int f = 0; f < db.frame_count; ++f) REQUIRE(seen[static_cast<size_t>(f)] == db.searchable[static_cast<size_t>(f)]);
+        for (int q = 0; q < 400; ++q, ++queries) {
+            std::array<float, kMatchFeatureCount> query{};
+            const int kind = q % 8;
+            const int near = static_cast<int>(test::fixture_next(rng) % static_cast<std::uint64_t>(db.frame_count));
+            const int one = static_cast<int>(test::fixture_next(rng) % kMatchFeatureCount);
+            const double scale = kind == 1 ? std::pow(10.0, 1.0 + 5.0 * test::fixture_unit(rng)) : 1.0;
+            for (int k = 0; k < kMatchFeatureCount; ++k) {
+                const double u = test::fixture_unit(rng) * 2.0 - 1.0;
+                const float x = db.frame_features(near)[k];
+                float v = 0.0f;
+                switch (kind) {
+                    case 0: v = static_cast<float>(u * 4.0); break;
+                    case 1: v = static_cast<float>(u * scale); break;
+                    case 2: v = static_cast<float>(u * 1e20); break;
+                    case 3: case 4: v = x; break;
+                    case 5: v = x + static_cast<float>(u * 0.05); break;
+                    case 6: v = k == one ? static_cast<float>(u * 3.0) : 0.0f; break;
+                    default: v = k == one ? NAN : x; break;
+                }
+                query[static_cast<size_t>(k)] = v;
+            }
+            MatchingResult start;
+            if (q % 3 == 1) start = {near, matching_cost(db, query, near)};
+            if (q % 3 == 2) {  // a candidate with exactly the answer's cost, above or below its frame
+                const MatchingResult answer = search_matching_brute_force(db, query);
+                if (answer.frame >= 0) start = {answer.frame + ((q / 3) % 2 == 0 ? 1 : -1), answer.cost};
+            }
+            const MatchingResult brute = search_matching_brute_force(db, query, start);
+            const MatchingResult fast = search_matching_accelerated(db, query, start);
+            INFO("database of " << db.frame_count << " frames, query " << q << " kind " << kind);
+            REQUIRE(fast.frame == brute.frame);
+            REQUIRE(bits(fast.cost) == bits(brute.cost));
+            if (kind == 2) {
+                CHECK(std::isinf(brute.cost));
+                infinite += brute.frame >= 0;
+            }
+            if (kind == 7) CHECK(brute.frame == start.frame);  // NaN: nothing beats the candidate
+            exact_ties += kind == 3 && brute.cost == 0.0f && brute.frame < near;
+        }
+    }
+    CHECK(queries >= 1000);
+    CHECK(exact_ties > 0);  // the duplicated clips and the grid did produce ties
+    CHECK(infinite > 0);
 }
