@@ -41,8 +41,8 @@ SimulationLoop::SimulationLoop(const SimConfig& config, PipelineShared& shared,
 void SimulationLoop::apply(const SimConfig& config, TickRecord::ConfigSource source, std::uint32_t id) {
     // The watcher refused structural changes already, and a log's changes were
     // checked when it was decoded, so retune cannot fail here. It copies the
-    // configuration into the simulation's; the terrain is structural, so its
-    // arrays have the same sizes and the copy reuses their storage.
+    // configuration into the simulation's; only a terrain edit (rare, made by
+    // hand) grows the terrain's arrays, every other change reuses their storage.
     if (!sim_.retune(config).ok()) return;
     ++config_changes_;
     record_.kind = TickRecord::Kind::config_change;
@@ -353,7 +353,7 @@ struct DisplayThreadState {
 struct RenderInputs {
     const DisplayOptions* display = nullptr;
     const Skeleton* skeleton = nullptr;
-    const Terrain* terrain = nullptr;
+    const Terrain* terrain = nullptr;  // the terrain at the start (then PipelineShared::applied_terrain)
     float ankle_height = 0.08f;
     int tick_rate_hz = 240;
     Interpolation interpolation = Interpolation::interpolate;
@@ -391,6 +391,14 @@ void feed_tuning_ui(ui::TuningUi* tuning, PipelineShared& sh, const StateFrame& 
     sh.ui_captures_input.store(tuning->is_open(), std::memory_order_relaxed);
 }
 
+// Before a frame: a terrain the simulation now walks on replaces the drawn
+// ground (the mesh is rebuilt here, on the render thread, once per edit).
+void take_applied_terrain(PipelineShared& sh, render::View* view, Terrain& drawn_terrain) {
+    if (!sh.applied_terrain.take()) return;
+    drawn_terrain = sh.applied_terrain.front();
+    if (view != nullptr) view->renderer().set_terrain(drawn_terrain);
+}
+
 // After a frame: an edit made in it goes to the writer.
 void hand_over_ui_edit(ui::TuningUi* tuning, PipelineShared& sh) {
     if (tuning != nullptr && tuning->take_edit(sh.ui_edits.back().config)) sh.ui_edits.publish();
@@ -402,10 +410,11 @@ void hand_over_ui_edit(ui::TuningUi* tuning, PipelineShared& sh) {
 void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, RenderInputs in,
                    DisplayThreadState& display, FrameTimeHistogram& frame_time, PresentLatency& present) {
     FrameLoop frames(sh, in.interpolation);
+    Terrain terrain = *in.terrain;  // the ground drawn: the start's, then each edit's
     std::unique_ptr<render::View> view;
     if (in.display->gl) {
         try {
-            view = std::make_unique<render::View>(in.display->platform, in.display->settings, *in.skeleton, *in.terrain);
+            view = std::make_unique<render::View>(in.display->platform, in.display->settings, *in.skeleton, terrain);
             display.description = view->platform().description();
             display.state.store(DisplayThreadState::ready, std::memory_order_release);
         } catch (const std::exception& e) {
@@ -448,7 +457,8 @@ void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, Ren
             const float alpha = static_cast<float>(frames.alpha());
             if (alpha > 1.0f) render::extrapolate_state(pair.previous, pair.current, alpha - 1.0f, drawn);
             else render::interpolate_state(pair.previous, pair.current, alpha, drawn);
-            render::feet_overlay_from_state(drawn, *in.terrain, in.ankle_height, overlay);
+            take_applied_terrain(sh, view.get(), terrain);
+            render::feet_overlay_from_state(drawn, terrain, in.ankle_height, overlay);
             const PipelineCounters& c = sh.counters;
             const float speed = std::sqrt(drawn.velocity.x * drawn.velocity.x + drawn.velocity.y * drawn.velocity.y);
             // The stats overlay, formatted into fixed space (no allocation in the frame).
@@ -625,7 +635,7 @@ struct LiveTuning {
 // and the run's distance and top speed.
 class RecordWriter {
 public:
-    RecordWriter(const PipelineOptions& o, const Simulation& sim, const PipelineShared& sh, const LiveTuning& tuning,
+    RecordWriter(const PipelineOptions& o, const Simulation& sim, PipelineShared& sh, const LiveTuning& tuning,
                  PipelineResult& result)
         : o_(o), sh_(sh), tuning_(tuning), result_(result), tick_rate_hz_(o.config.tick_rate_hz),
           flush_ticks_(static_cast<std::uint32_t>(o.config.tick_rate_hz / 4)), logged_config_(o.config),
@@ -692,6 +702,11 @@ private:
                                        ? o_.scheduled_changes.at(r.config_id).config
                                        : tuning_.history.at(r.config_id - 1);
         if (log_) log_->append_config_change(serialize_config(applied));
+        if (!(applied.terrain == logged_config_.terrain)) {
+            // The simulation walks on it from this tick on: the renderer redraws the ground.
+            sh_.applied_terrain.back() = applied.terrain;
+            sh_.applied_terrain.publish();
+        }
         fmt::print(o_.out, "[{:6.1f} s] config: applied before tick {}: {}\n", seconds, r.tick,
                    config_diff(logged_config_, applied));
         logged_config_ = applied;
@@ -735,7 +750,7 @@ private:
     }
 
     const PipelineOptions& o_;
-    const PipelineShared& sh_;
+    PipelineShared& sh_;
     const LiveTuning& tuning_;
     PipelineResult& result_;
     const int tick_rate_hz_;
@@ -887,7 +902,7 @@ private:
     void start_display() {
         const Simulation& sim = loop_->simulation();
         const RenderInputs inputs{&o_.display,       &sim.skeleton(),
-                                  &sim.terrain(),    o_.config.ankle_height,
+                                  &o_.config.terrain, o_.config.ankle_height,
                                   o_.config.tick_rate_hz, o_.interpolation,
                                   o_.test_render_stall_after_frames, o_.test_render_stall_ns,
                                   o_.ui ? &ui_options_ : nullptr};
