@@ -376,6 +376,7 @@ std::unique_ptr<ui::TuningUi> open_tuning_ui(render::View* view, const RenderInp
 void feed_tuning_ui(ui::TuningUi* tuning, PipelineShared& sh, const StateFrame& pair) {
     if (tuning == nullptr) return;
     if (sh.accepted_configs.take()) tuning->adopt(sh.accepted_configs.front());
+    tuning->set_puppet_position(pair.current.root_position.x, pair.current.root_position.z);
     // One press a frame, in order: ImGui sees each go down in one frame and up
     // in the next, so a d-pad move and the south press after it stay in order
     // however slow the frames are.
