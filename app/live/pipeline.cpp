@@ -531,9 +531,18 @@ std::string config_diff(const SimConfig& from, const SimConfig& to) {
     const auto a = config_lines(from);
     const auto b = config_lines(to);
     std::string out;
+    const auto terrain_line = [](const std::string& key) { return key.rfind("terrain", 0) == 0 || key.rfind("[terrain", 0) == 0; };
     for (size_t i = 0; i < a.size() && i < b.size(); ++i)
-        if (a[i].second != b[i].second)
+        if (a[i].second != b[i].second && !terrain_line(a[i].first) && !terrain_line(b[i].first))
             out += (out.empty() ? "" : ", ") + a[i].first + " " + a[i].second + " → " + b[i].second;
+    if (!(from.terrain == to.terrain)) {
+        // Terrain lines (the table's data) differ in number: counted, not listed.
+        const auto count = [](const Terrain& t) {
+            return fmt::format("{} box(es), {} slope(s), heightfield {}x{}", t.boxes.size(), t.slopes.size(),
+                               t.heightfield.nx, t.heightfield.nz);
+        };
+        out += (out.empty() ? "" : ", ") + std::string("terrain ") + count(from.terrain) + " → " + count(to.terrain);
+    }
     return out.empty() ? "no change" : out;
 }
 

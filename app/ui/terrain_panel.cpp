@@ -2,6 +2,7 @@
 // editor"): rows of step buttons, each press one TerrainAction on the working
 // terrain (terrain_edit.hpp does the edit), handed over like a slider's edit.
 #include <imgui.h>
+#include <imgui_internal.h>  // SetFocusID: west puts the pad on the section's first button
 
 #include <cstdio>
 #include <string>
@@ -141,12 +142,22 @@ void TuningUi::terrain_buttons(const char* label, std::initializer_list<std::pai
         ImGui::SameLine();
         ImGui::PushID(static_cast<int>(action));
         if (ImGui::SmallButton(text)) (void)terrain_action(action);
+        if (jump_to_terrain_ && action == TerrainAction::add_box) {
+            // West: the pad lands on "add box", scrolled into view, held for a few
+            // frames past ImGui's own focus handling (as the first slider's is).
+            ImGui::SetFocusID(ImGui::GetItemID(), ImGui::GetCurrentWindow());
+            ImGui::GetCurrentContext()->NavDisableHighlight = false;
+            ImGui::GetCurrentContext()->NavDisableMouseHover = true;
+            ImGui::SetScrollHereY(0.2f);
+            if (++jump_frames_ >= 3) jump_to_terrain_ = false;
+        }
         ImGui::PopID();
     }
 }
 
 void TuningUi::draw_terrain_section() {
-    // Collapsed at first: the pad reaches it below the sliders.
+    // Collapsed at first: the pad reaches it below the sliders, or at once with west.
+    if (jump_to_terrain_) ImGui::SetNextItemOpen(true);
     if (!ImGui::CollapsingHeader("[terrain] editor")) return;
     const Terrain& t = working_.sim.terrain;
     ImGui::Text("%s; the puppet at x %.2f z %.2f", describe(t).c_str(), static_cast<double>(puppet_x_),

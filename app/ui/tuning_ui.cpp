@@ -248,6 +248,11 @@ void TuningUi::feed_navigation() {
     io.NavInputs[ImGuiNavInput_LStickDown] = std::max(0.0f, -ly);
     // North saves (our shortcut; ImGui's own use of it, text input, is not needed here).
     if (press_ & button_bit(Button::north)) save(std::string(path_buffer_.data()));
+    // West jumps to the terrain editor (opened, its first button focused): far below the sliders otherwise.
+    if (press_ & button_bit(Button::west)) {
+        jump_to_terrain_ = true;
+        jump_frames_ = 0;
+    }
 }
 
 void TuningUi::draw(std::int32_t width, std::int32_t height, float dt_s) {

@@ -93,8 +93,9 @@ public:
                   bool caught_up);
     // This frame takes no press event: the last frame showed a step and this one
     // shows it released, or the panel, just opened, is still putting the focus on
-    // its first slider (a step taken then would be undone by it).
-    bool releasing() const { return stepper_.releasing() || focus_first_; }
+    // its first slider (a step taken then would be undone by it), or west just
+    // moved it to the terrain editor.
+    bool releasing() const { return stepper_.releasing() || focus_first_ || jump_to_terrain_; }
     bool is_open() const { return open_; }
     void set_open(bool open);
     // A configuration the writer thread has accepted (a file edit, or ours).
@@ -169,6 +170,8 @@ private:
     bool message_problem_ = false;
     float puppet_x_ = 0.0f, puppet_z_ = 0.0f;
     int selected_box_ = -1, selected_slope_ = -1;  // -1: none
+    bool jump_to_terrain_ = false;  // west was pressed: open the terrain section, focus its first button
+    int jump_frames_ = 0;
 };
 
 }  // namespace marionette::ui

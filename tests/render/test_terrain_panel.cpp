@@ -10,6 +10,7 @@
 
 #include "app/config/config.hpp"
 #include "app/config/terrain_file.hpp"
+#include "app/ui/pad_presses.hpp"
 #include "app/ui/tuning_ui.hpp"
 #include "render_es/view.hpp"
 #include "runtime/gait/puppet.hpp"
@@ -116,4 +117,52 @@ TEST_CASE("generated terrain editor step sequences stay loadable and the simulat
     }
     CHECK(taken > 100);
     CHECK(sim.terrain() == tuning.working().sim.terrain);
+}
+
+TEST_CASE("west takes the pad to the terrain editor, south adds a box, down to Save terrain saves", "[render][ui][terrain]") {
+    AppConfig base = default_config();  // the stairs
+    render::View view(panel_platform(), render::RenderSettings{}, make_puppet_skeleton(base.sim), base.sim.terrain);
+    ui::TuningUi tuning(view.platform(), ui::TuningUiOptions{base, "", "", stderr});
+    view.set_layer(&tuning);
+    std::uint32_t held = 0;
+    std::uint64_t tick = 0;
+    auto frame_with = [&](std::uint32_t buttons) {
+        const std::uint32_t event = ui::press_event(held, buttons);
+        held = buttons;
+        TickInput pad;
+        pad.buttons = buttons;
+        ++tick;
+        tuning.feed_pad(pad, tick, 8'333'333, ui::PadPress{event, tick}, true);
+        view.frame(PuppetState{}, render::DebugOverlay{}, "", 1.0f / 60.0f);
+    };
+    auto press = [&](Button b) {
+        frame_with(button_bit(b));
+        frame_with(0);
+    };
+    frame_with(0);
+    frame_with(ui::kUiChord);
+    REQUIRE(tuning.is_open());
+    for (int i = 0; i < 4; ++i) frame_with(0);
+    const std::size_t boxes = base.sim.terrain.boxes.size();
+    // West: the terrain editor opens with the pad on its first button, add box.
+    press(Button::west);
+    for (int i = 0; i < 4; ++i) frame_with(0);  // the panel settles the focus (releasing() holds presses meanwhile)
+    CHECK_FALSE(tuning.releasing());
+    press(Button::south);
+    INFO("message: " << tuning.message());
+    CHECK(tuning.working().sim.terrain.boxes.size() == boxes + 1);
+    AppConfig handed;
+    CHECK(tuning.take_edit(handed));
+    // Down through the rows to Save terrain: box, box size, slope, slope grade, two sliders, heightfield, Save.
+    for (int i = 0; i < 8; ++i) press(Button::dpad_down);
+    press(Button::south);
+    CHECK_THAT(tuning.message(), Catch::Contains("saved the terrain"));
+    CHECK(load_terrain("marionette-terrain.toml") == tuning.working().sim.terrain);
+    std::filesystem::remove("marionette-terrain.toml");
+    // No slider was touched on the way.
+    CHECK(serialize_config(handed.sim) == [&] {
+        SimConfig expected = base.sim;
+        expected.terrain = handed.sim.terrain;
+        return serialize_config(expected);
+    }());
 }

@@ -1,9 +1,8 @@
 #!/usr/bin/env bash
 # The terrain editor end to end under Xvfb (docs/ui.md, "Terrain editor"): `run`
-# in an SDL window with a simulated pad that opens the UI by the chord, holds the
-# d-pad down to the collapsed [terrain] editor section, opens it, adds a box
-# under the puppet, holds down to "Save terrain" and presses it, closes the UI
-# and walks onto the box. The edit is applied at a tick boundary and recorded,
+# in an SDL window with a simulated pad that opens the UI by the chord, jumps to
+# the [terrain] editor with west, adds a box under the puppet with south, steps
+# down to "Save terrain" and presses it, closes the UI and walks onto the box. The edit is applied at a tick boundary and recorded,
 # `replay` of the recording gives the run's final hash, and the saved terrain
 # file holds the stairs' boxes plus the new one.
 # Usage: ui_terrain_xvfb_tests.sh MARIONETTE_BINARY SOURCE_DIR
@@ -27,22 +26,33 @@ fi
 mkdir -p home/.config/marionette
 printf '[display]\nwidth = 640\nheight = 400\nmsaa_samples = 0\n' >home/.config/marionette/render.toml
 
-# A held d-pad steps once, then every 0.1 s after 0.5 s (app/ui/pad_presses.hpp):
-# 9 s is past every row of the panel, where navigation stops on the last item.
+# West jumps to the terrain editor (opened, the pad on "add box"); each tap is
+# one step however slow the frames (app/ui/pad_presses.hpp); eight downs reach
+# "Save terrain" (box, box size, slope, slope grade, two sliders, heightfield, Save).
 cat >terrain.prog <<'PROG'
 hold 1s
 press back+start 200ms
 hold 800ms
-press dpad_down 9s
-hold 500ms
-press south 150ms
+press west 150ms
 hold 800ms
+press south 150ms
+hold 500ms
 press dpad_down 150ms
-hold 800ms
-press south 150ms
-hold 800ms
-press dpad_down 4s
-hold 500ms
+hold 300ms
+press dpad_down 150ms
+hold 300ms
+press dpad_down 150ms
+hold 300ms
+press dpad_down 150ms
+hold 300ms
+press dpad_down 150ms
+hold 300ms
+press dpad_down 150ms
+hold 300ms
+press dpad_down 150ms
+hold 300ms
+press dpad_down 150ms
+hold 300ms
 press south 150ms
 hold 1s
 press back+start 200ms
@@ -53,14 +63,14 @@ ramp 300ms ly=0
 hold 1s
 PROG
 
-HOME=$work/home XDG_CONFIG_HOME=$work/home/.config LIBGL_ALWAYS_SOFTWARE=1 xvfb-run -a -s "-screen 0 800x600x24" "$bin" run --display window --input sim:terrain.prog --duration 22 \
+HOME=$work/home XDG_CONFIG_HOME=$work/home/.config LIBGL_ALWAYS_SOFTWARE=1 xvfb-run -a -s "-screen 0 800x600x24" "$bin" run --display window --input sim:terrain.prog --duration 16 \
   --record terrain.mlog --stats-json stats.json >run.txt 2>run.err
 code=$?
 check "run under Xvfb exits 0 (got $code)" test $code -eq 0
 check "the chord opened the UI" grep -q "^ui: opened" run.txt
 check "the pad added a box under the puppet" grep -q "^ui: terrain: added box [0-9]* under the puppet" run.txt
 check "no slider moved on the way down" bash -c "! grep -qE '^ui: [a-z_]+\.[a-z_]+ ' run.txt"
-check "the edit was applied at a tick boundary" grep -q "config: applied before tick" run.txt
+check "the edit was applied at a tick boundary, one more box" grep -qE "config: applied before tick [0-9]+: terrain 63 box\(es\), 0 slope\(s\), heightfield 0x0 → 64 box\(es\)" run.txt
 check "Save terrain wrote marionette-terrain.toml" grep -q "^ui: saved the terrain .* to marionette-terrain.toml" run.txt
 boxes=$(grep -c '^\[\[box\]\]' marionette-terrain.toml 2>/dev/null)
 stairs=$(grep -c '^\[\[box\]\]' "$src/config/terrain/stairs.toml")
