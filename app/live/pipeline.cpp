@@ -353,7 +353,9 @@ struct DisplayThreadState {
 struct RenderInputs {
     const DisplayOptions* display = nullptr;
     const Skeleton* skeleton = nullptr;
-    const Terrain* terrain = nullptr;  // the terrain at the start (then PipelineShared::applied_terrain)
+    // The ground drawn, the render thread's once it starts: the start's (copied
+    // before, so the thread allocates nothing for it), then each applied edit's.
+    Terrain* terrain = nullptr;
     float ankle_height = 0.08f;
     int tick_rate_hz = 240;
     Interpolation interpolation = Interpolation::interpolate;
@@ -411,7 +413,7 @@ void hand_over_ui_edit(ui::TuningUi* tuning, PipelineShared& sh) {
 void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, RenderInputs in,
                    DisplayThreadState& display, FrameTimeHistogram& frame_time, PresentLatency& present) {
     FrameLoop frames(sh, in.interpolation);
-    Terrain terrain = *in.terrain;  // the ground drawn: the start's, then each edit's
+    Terrain& terrain = *in.terrain;
     std::unique_ptr<render::View> view;
     if (in.display->gl) {
         try {
@@ -911,8 +913,9 @@ private:
 
     void start_display() {
         const Simulation& sim = loop_->simulation();
+        drawn_terrain_ = o_.config.terrain;  // copied here, on the writer's thread
         const RenderInputs inputs{&o_.display,       &sim.skeleton(),
-                                  &o_.config.terrain, o_.config.ankle_height,
+                                  &drawn_terrain_,   o_.config.ankle_height,
                                   o_.config.tick_rate_hz, o_.interpolation,
                                   o_.test_render_stall_after_frames, o_.test_render_stall_ns,
                                   o_.ui ? &ui_options_ : nullptr};
@@ -995,6 +998,7 @@ private:
     SimulationThreadResult sim_result_;
     DisplayThreadState display_;
     ui::TuningUiOptions ui_options_{o_.ui_base, o_.ui_config_file, "", o_.out};
+    Terrain drawn_terrain_;  // the render thread's (RenderInputs::terrain)
     std::thread sim_thread_, in_thread_, gfx_thread_;
     std::unique_ptr<input::InputThread> device_ = std::make_unique<input::InputThread>();  // stopped (joined) by its destructor
     ThreadGuard guard_{{&sim_thread_, &in_thread_, &gfx_thread_}, sh_};
