@@ -546,8 +546,12 @@ std::string serialize_config(const SimConfig& config) {
     out += serialize_prototypes(config.walk, "gait.walk");
     out += serialize_prototypes(config.run, "gait.run");
     out += serialize_buttons(config);
-    // The terrain, resolved and inline: the text alone determines the ground.
-    out += "\n[terrain]\nname = " + toml_string(config.terrain_name) + "\n";
+    // The terrain, resolved and inline: the text alone determines the ground. An
+    // empty one (every feature edited away) has no inline data to win over its
+    // name, so it is named as the built-in empty terrain.
+    const Terrain& t = config.terrain;
+    const bool empty = t.boxes.empty() && t.slopes.empty() && !(t.heightfield.nx >= 2 && t.heightfield.nz >= 2);
+    out += "\n[terrain]\nname = " + toml_string(empty ? std::string("flat") : config.terrain_name) + "\n";
     out += serialize_terrain(config.terrain, "terrain.");
     return out;
 }

@@ -41,8 +41,8 @@ SimulationLoop::SimulationLoop(const SimConfig& config, PipelineShared& shared,
 void SimulationLoop::apply(const SimConfig& config, TickRecord::ConfigSource source, std::uint32_t id) {
     // The watcher refused structural changes already, and a log's changes were
     // checked when it was decoded, so retune cannot fail here. It copies the
-    // configuration into the simulation's; the terrain is structural, so its
-    // arrays have the same sizes and the copy reuses their storage.
+    // configuration into the simulation's; only a terrain edit (rare, made by
+    // hand) grows the terrain's arrays, every other change reuses their storage.
     if (!sim_.retune(config).ok()) return;
     ++config_changes_;
     record_.kind = TickRecord::Kind::config_change;
@@ -353,7 +353,9 @@ struct DisplayThreadState {
 struct RenderInputs {
     const DisplayOptions* display = nullptr;
     const Skeleton* skeleton = nullptr;
-    const Terrain* terrain = nullptr;
+    // The ground drawn, the render thread's once it starts: the start's (copied
+    // before, so the thread allocates nothing for it), then each applied edit's.
+    Terrain* terrain = nullptr;
     float ankle_height = 0.08f;
     int tick_rate_hz = 240;
     Interpolation interpolation = Interpolation::interpolate;
@@ -376,6 +378,7 @@ std::unique_ptr<ui::TuningUi> open_tuning_ui(render::View* view, const RenderInp
 void feed_tuning_ui(ui::TuningUi* tuning, PipelineShared& sh, const StateFrame& pair) {
     if (tuning == nullptr) return;
     if (sh.accepted_configs.take()) tuning->adopt(sh.accepted_configs.front());
+    tuning->set_puppet_position(pair.current.root_position.x, pair.current.root_position.z);
     // One press a frame, in order: ImGui sees each go down in one frame and up
     // in the next, so a d-pad move and the south press after it stay in order
     // however slow the frames are.
@@ -391,6 +394,14 @@ void feed_tuning_ui(ui::TuningUi* tuning, PipelineShared& sh, const StateFrame& 
     sh.ui_captures_input.store(tuning->is_open(), std::memory_order_relaxed);
 }
 
+// Before a frame: a terrain the simulation now walks on replaces the drawn
+// ground (the mesh is rebuilt here, on the render thread, once per edit).
+void take_applied_terrain(PipelineShared& sh, render::View* view, Terrain& drawn_terrain) {
+    if (!sh.applied_terrain.take()) return;
+    drawn_terrain = sh.applied_terrain.front();
+    if (view != nullptr) view->renderer().set_terrain(drawn_terrain);
+}
+
 // After a frame: an edit made in it goes to the writer.
 void hand_over_ui_edit(ui::TuningUi* tuning, PipelineShared& sh) {
     if (tuning != nullptr && tuning->take_edit(sh.ui_edits.back().config)) sh.ui_edits.publish();
@@ -402,10 +413,11 @@ void hand_over_ui_edit(ui::TuningUi* tuning, PipelineShared& sh) {
 void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, RenderInputs in,
                    DisplayThreadState& display, FrameTimeHistogram& frame_time, PresentLatency& present) {
     FrameLoop frames(sh, in.interpolation);
+    Terrain& terrain = *in.terrain;
     std::unique_ptr<render::View> view;
     if (in.display->gl) {
         try {
-            view = std::make_unique<render::View>(in.display->platform, in.display->settings, *in.skeleton, *in.terrain);
+            view = std::make_unique<render::View>(in.display->platform, in.display->settings, *in.skeleton, terrain);
             display.description = view->platform().description();
             display.state.store(DisplayThreadState::ready, std::memory_order_release);
         } catch (const std::exception& e) {
@@ -448,7 +460,8 @@ void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, Ren
             const float alpha = static_cast<float>(frames.alpha());
             if (alpha > 1.0f) render::extrapolate_state(pair.previous, pair.current, alpha - 1.0f, drawn);
             else render::interpolate_state(pair.previous, pair.current, alpha, drawn);
-            render::feet_overlay_from_state(drawn, *in.terrain, in.ankle_height, overlay);
+            take_applied_terrain(sh, view.get(), terrain);
+            render::feet_overlay_from_state(drawn, terrain, in.ankle_height, overlay);
             const PipelineCounters& c = sh.counters;
             const float speed = std::sqrt(drawn.velocity.x * drawn.velocity.x + drawn.velocity.y * drawn.velocity.y);
             // The stats overlay, formatted into fixed space (no allocation in the frame).
@@ -520,9 +533,18 @@ std::string config_diff(const SimConfig& from, const SimConfig& to) {
     const auto a = config_lines(from);
     const auto b = config_lines(to);
     std::string out;
+    const auto terrain_line = [](const std::string& key) { return key.rfind("terrain", 0) == 0 || key.rfind("[terrain", 0) == 0; };
     for (size_t i = 0; i < a.size() && i < b.size(); ++i)
-        if (a[i].second != b[i].second)
+        if (a[i].second != b[i].second && !terrain_line(a[i].first) && !terrain_line(b[i].first))
             out += (out.empty() ? "" : ", ") + a[i].first + " " + a[i].second + " → " + b[i].second;
+    if (!(from.terrain == to.terrain)) {
+        // Terrain lines (the table's data) differ in number: counted, not listed.
+        const auto count = [](const Terrain& t) {
+            return fmt::format("{} box(es), {} slope(s), heightfield {}x{}", t.boxes.size(), t.slopes.size(),
+                               t.heightfield.nx, t.heightfield.nz);
+        };
+        out += (out.empty() ? "" : ", ") + std::string("terrain ") + count(from.terrain) + " → " + count(to.terrain);
+    }
     return out.empty() ? "no change" : out;
 }
 
@@ -625,7 +647,7 @@ struct LiveTuning {
 // and the run's distance and top speed.
 class RecordWriter {
 public:
-    RecordWriter(const PipelineOptions& o, const Simulation& sim, const PipelineShared& sh, const LiveTuning& tuning,
+    RecordWriter(const PipelineOptions& o, const Simulation& sim, PipelineShared& sh, const LiveTuning& tuning,
                  PipelineResult& result)
         : o_(o), sh_(sh), tuning_(tuning), result_(result), tick_rate_hz_(o.config.tick_rate_hz),
           flush_ticks_(static_cast<std::uint32_t>(o.config.tick_rate_hz / 4)), logged_config_(o.config),
@@ -692,6 +714,11 @@ private:
                                        ? o_.scheduled_changes.at(r.config_id).config
                                        : tuning_.history.at(r.config_id - 1);
         if (log_) log_->append_config_change(serialize_config(applied));
+        if (!(applied.terrain == logged_config_.terrain)) {
+            // The simulation walks on it from this tick on: the renderer redraws the ground.
+            sh_.applied_terrain.back() = applied.terrain;
+            sh_.applied_terrain.publish();
+        }
         fmt::print(o_.out, "[{:6.1f} s] config: applied before tick {}: {}\n", seconds, r.tick,
                    config_diff(logged_config_, applied));
         logged_config_ = applied;
@@ -735,7 +762,7 @@ private:
     }
 
     const PipelineOptions& o_;
-    const PipelineShared& sh_;
+    PipelineShared& sh_;
     const LiveTuning& tuning_;
     PipelineResult& result_;
     const int tick_rate_hz_;
@@ -886,8 +913,9 @@ private:
 
     void start_display() {
         const Simulation& sim = loop_->simulation();
+        drawn_terrain_ = o_.config.terrain;  // copied here, on the writer's thread
         const RenderInputs inputs{&o_.display,       &sim.skeleton(),
-                                  &sim.terrain(),    o_.config.ankle_height,
+                                  &drawn_terrain_,   o_.config.ankle_height,
                                   o_.config.tick_rate_hz, o_.interpolation,
                                   o_.test_render_stall_after_frames, o_.test_render_stall_ns,
                                   o_.ui ? &ui_options_ : nullptr};
@@ -970,6 +998,7 @@ private:
     SimulationThreadResult sim_result_;
     DisplayThreadState display_;
     ui::TuningUiOptions ui_options_{o_.ui_base, o_.ui_config_file, "", o_.out};
+    Terrain drawn_terrain_;  // the render thread's (RenderInputs::terrain)
     std::thread sim_thread_, in_thread_, gfx_thread_;
     std::unique_ptr<input::InputThread> device_ = std::make_unique<input::InputThread>();  // stopped (joined) by its destructor
     ThreadGuard guard_{{&sim_thread_, &in_thread_, &gfx_thread_}, sh_};

@@ -137,6 +137,9 @@ struct PipelineShared {
     ui::PadEventRing pad_events;       // presses with their ticks, in order (ui::press_event)
     LatestValue<UiEdit> ui_edits;
     LatestValue<SimConfig> accepted_configs;
+    // The terrain the simulation walks on after a terrain edit it applied
+    // (writer → render thread, which rebuilds its ground mesh from it).
+    LatestValue<Terrain> applied_terrain;
     // Virtual time only: the newest timestamp the input thread has pushed.
     std::atomic<std::int64_t> input_watermark_ns{INT64_MIN};
     std::atomic<bool> input_done{false};

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "app/config/terrain_file.hpp"
+#include "app/io/files.hpp"
 
 namespace marionette::ui {
 
@@ -45,13 +46,6 @@ void grow(float& lo, float& hi, float d) {
     lo = centre - half;
     hi = centre + half;
     if (!(hi > lo)) hi = lo + kMinFeatureSize;  // far from the origin half a side may round away
-}
-
-std::string read_text(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
 }
 
 }  // namespace
@@ -158,7 +152,13 @@ std::string save_terrain_file(const Terrain& terrain, const std::string& path) {
     // it are written anew, in serialize_terrain's order).
     std::string header;
     if (std::filesystem::exists(path)) {
-        std::istringstream old(read_text(path));
+        std::string old_text;
+        try {
+            old_text = read_text_file(path);
+        } catch (const std::exception& e) {
+            return std::string("not written: ") + e.what();  // names the file and why it cannot be read
+        }
+        std::istringstream old(old_text);
         for (std::string line; std::getline(old, line);) {
             const std::size_t first = line.find_first_not_of(" \t");
             if (first != std::string::npos && line[first] != '#') break;

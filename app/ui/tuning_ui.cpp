@@ -10,9 +10,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "app/config/config.hpp"
+#include "app/io/files.hpp"
 #include "app/ui/toml_edit.hpp"
 #include "render_es/imgui_gles3.hpp"
 
@@ -42,17 +42,6 @@ std::vector<PanelKey> panel_keys() {
     std::stable_sort(out.begin(), out.end(), [&](const PanelKey& a, const PanelKey& b) { return rank(a) < rank(b); });
     return out;
 }
-
-namespace {
-
-std::string read_text(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
-}  // namespace
 
 TuningUi::TuningUi(render::Platform& platform, TuningUiOptions options)
     : platform_(platform), options_(std::move(options)), defaults_(default_config()), working_(options_.base),
@@ -160,7 +149,13 @@ bool TuningUi::save(const std::string& path) {
         return false;
     }
     const bool exists = std::filesystem::exists(path);
-    std::string text = exists ? read_text(path) : "# marionette configuration, saved by the tuning UI (docs/ui.md)\n";
+    std::string text = "# marionette configuration, saved by the tuning UI (docs/ui.md)\n";
+    try {
+        if (exists) text = read_text_file(path);
+    } catch (const std::exception& e) {
+        say("save: not written: " + std::string(e.what()), true);  // names the file and why it cannot be read
+        return false;
+    }
     for (const std::string& full : edited_) {
         const std::size_t dot = full.rfind('.');
         const std::string table = full.substr(0, dot);
@@ -253,6 +248,11 @@ void TuningUi::feed_navigation() {
     io.NavInputs[ImGuiNavInput_LStickDown] = std::max(0.0f, -ly);
     // North saves (our shortcut; ImGui's own use of it, text input, is not needed here).
     if (press_ & button_bit(Button::north)) save(std::string(path_buffer_.data()));
+    // West jumps to the terrain editor (opened, its first button focused): far below the sliders otherwise.
+    if (press_ & button_bit(Button::west)) {
+        jump_to_terrain_ = true;
+        jump_frames_ = 0;
+    }
 }
 
 void TuningUi::draw(std::int32_t width, std::int32_t height, float dt_s) {

@@ -15,6 +15,8 @@
 #include <array>
 #include <cstdint>
 #include <cstdio>
+#include <initializer_list>
+#include <utility>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -57,6 +59,22 @@ struct PanelKey {
 // tables and in schema order within each.
 std::vector<PanelKey> panel_keys();
 
+// One step of the terrain editor (docs/ui.md, "Terrain editor"), as a pad press
+// on one of its buttons makes it: features are added under the puppet, the
+// selected box or slope moves, grows, tilts or goes, the brush raises or lowers
+// the heightfield under the puppet.
+enum class TerrainAction {
+    add_box, add_slope, select_next_box, select_next_slope,
+    box_x_minus, box_x_plus, box_z_minus, box_z_plus, box_lower, box_raise,
+    box_narrower, box_wider, box_shorter, box_longer, box_delete,
+    slope_x_minus, slope_x_plus, slope_z_minus, slope_z_plus, slope_lower, slope_raise,
+    slope_tilt_x_minus, slope_tilt_x_plus, slope_tilt_z_minus, slope_tilt_z_plus, slope_delete,
+    brush_raise, brush_lower,
+};
+inline constexpr float kTerrainMoveStep = 0.1f;   // m per press: moves and resizes
+inline constexpr float kTerrainHeightStep = 0.02f;  // m per press: box tops, slope bases
+inline constexpr float kTerrainGradeStep = 0.05f;   // rise/run per press
+
 class TuningUi final : public render::ViewLayer, public render::NativeEventHook {
 public:
     // On the render thread, with the platform's context current.
@@ -75,8 +93,9 @@ public:
                   bool caught_up);
     // This frame takes no press event: the last frame showed a step and this one
     // shows it released, or the panel, just opened, is still putting the focus on
-    // its first slider (a step taken then would be undone by it).
-    bool releasing() const { return stepper_.releasing() || focus_first_; }
+    // its first slider (a step taken then would be undone by it), or west just
+    // moved it to the terrain editor.
+    bool releasing() const { return stepper_.releasing() || focus_first_ || jump_to_terrain_; }
     bool is_open() const { return open_; }
     void set_open(bool open);
     // A configuration the writer thread has accepted (a file edit, or ours).
@@ -95,6 +114,26 @@ public:
     // reason in message(), when it cannot.
     bool save(const std::string& path);
 
+    // The terrain editor. The puppet's ground position (the newest state's
+    // root) is where new features and the brush go.
+    void set_puppet_position(float x, float z) {
+        puppet_x_ = x;
+        puppet_z_ = z;
+    }
+    // One editor step on the working terrain; handed over like a slider's edit,
+    // so the simulation walks on the result from a tick boundary and the log
+    // records it. False (message() says why) when it changes nothing.
+    bool terrain_action(TerrainAction action);
+    int selected_box() const { return selected_box_; }
+    int selected_slope() const { return selected_slope_; }
+    float brush_radius = 0.5f;  // m
+    float brush_step = 0.05f;   // m per press
+    // Writes the working terrain as a terrain file (save_terrain_file) to
+    // `path`; terrain_save_path() is the terrain's own file, or
+    // marionette-terrain.toml for a built-in or inline one.
+    bool save_terrain(const std::string& path);
+    std::string terrain_save_path() const;
+
     void draw(std::int32_t width, std::int32_t height, float dt_s) override;
     void recreate() override;
     bool on_native_event(const void* event) override;
@@ -103,6 +142,8 @@ private:
     void feed_navigation();
     void draw_panel(float width, float height);
     void draw_row(std::size_t index);
+    void draw_terrain_section();
+    void terrain_buttons(const char* label, std::initializer_list<std::pair<const char*, TerrainAction>> buttons);
     void say(const std::string& line, bool problem);
 
     render::Platform& platform_;
@@ -127,6 +168,10 @@ private:
     std::array<char, 512> path_buffer_{};
     std::string message_;
     bool message_problem_ = false;
+    float puppet_x_ = 0.0f, puppet_z_ = 0.0f;
+    int selected_box_ = -1, selected_slope_ = -1;  // -1: none
+    bool jump_to_terrain_ = false;  // west was pressed: open the terrain section, focus its first button
+    int jump_frames_ = 0;
 };
 
 }  // namespace marionette::ui

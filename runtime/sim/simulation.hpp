@@ -87,10 +87,10 @@ public:
 
     // Applies a new configuration at the tick boundary (live tuning). Structural
     // settings (tick rate, puppet proportions) cannot change while running: the
-    // call then changes nothing and fails naming the first such key. A new
-    // [motion] source starts a cross-fade; it is refused (named as
-    // "motion.source …") when it needs a graph and none is attached, or when it
-    // crosses between gait and graph and the graph's skeleton is not the puppet's.
+    // call then changes nothing and fails naming the first such key. A new terrain
+    // replaces the ground from the next tick on (a copy). A new [motion] source starts a
+    // cross-fade; it is refused ("motion.source …") when it needs a graph and none is
+    // attached, or crossing between gait and graph when the graph's skeleton is not the puppet's.
     Outcome retune(const SimConfig& config);
 
     const PuppetState& state() const { return state_; }
@@ -175,7 +175,7 @@ MatchingControllerConfig matching_controller_config(const SimConfig& config);
 std::int32_t resolve_motion_source(const SimConfig& config, bool graph_attached);
 
 // Ok when no structural setting (one that cannot change while running: tick
-// rate, puppet proportions, terrain) differs between two configurations,
+// rate, puppet proportions; the terrain can) differs between two configurations,
 // otherwise a failure naming the first that does.
 Outcome structure_unchanged(const SimConfig& running, const SimConfig& next);
 

@@ -222,6 +222,30 @@ TEST_CASE("after a lost context the view rebuilds everything and draws the same 
     CHECK(d.differing_pixels == 0);
 }
 
+TEST_CASE("a terrain edit redraws the ground: the same frame as a view opened on the edited terrain", "[render][terrain]") {
+    // What the render thread does when the simulation applied a terrain edit
+    // (app/live/pipeline.cpp, take_applied_terrain).
+    const Replayed r = replay_ticks("walk_stop", {700});
+    render::RenderSettings settings;
+    settings.camera.smoothing_s = 0.0f;
+    render::View view(golden_platform(), settings, r.skeleton, Terrain{});
+    view.frame(r.states[0], render::DebugOverlay{}, "", 0.0f);
+    const render::Image flat = snapshot(view);
+    const std::size_t flat_triangles = view.renderer().terrain_triangle_count();
+    view.renderer().set_terrain(test_steps());
+    view.frame(r.states[0], render::DebugOverlay{}, "", 0.0f);
+    const render::Image edited = snapshot(view);
+    CHECK(view.renderer().terrain_triangle_count() > flat_triangles);
+    CHECK(render::compare_images(flat, edited, kChannelTolerance).differing_pixels > 0);
+    view.renderer().set_terrain(Terrain{});
+    view.frame(r.states[0], render::DebugOverlay{}, "", 0.0f);
+    CHECK(render::compare_images(flat, snapshot(view), 0).differing_pixels == 0);
+    // Last: opening a second view makes its context current.
+    render::View fresh(golden_platform(), settings, r.skeleton, test_steps());
+    fresh.frame(r.states[0], render::DebugOverlay{}, "", 0.0f);
+    CHECK(render::compare_images(snapshot(fresh), edited, 0).differing_pixels == 0);
+}
+
 TEST_CASE("a frame allocates nothing once the view is open", "[render][alloc]") {
     const Replayed r = replay_ticks("circle", {400, 401, 402, 403});
     render::RenderSettings settings;
