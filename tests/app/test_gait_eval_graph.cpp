@@ -134,6 +134,8 @@ TEST_CASE("gait-eval: matching's joint speed stays under the limit where pin rel
     const AppConfig shipped = default_config();
     SimConfig config = shipped.sim;
     config.motion_source = MotionSourceSetting::matching;
+    config.terrain_name = "flat";  // the shipped configuration's terrain is not flat
+    config.terrain = load_terrain("flat");
     const auto graph = std::make_shared<const MotionGraph>(build_default_motion_graph(config, shipped.graph_build));
     for (const char* name : {"builtin:circle", "builtin:run"}) {
         INFO(name);
