@@ -15,6 +15,16 @@ vec3 unit_or(vec3 v, vec3 fallback) {
     const float n = length_of(v);
     return n > 1e-6f ? v / n : fallback;
 }
+// e^(−x) for x ≥ 0 as the rational 1 / (1 + x + 0.48x² + 0.235x³): no libm transcendental.
+float negexp(float x) { return 1.0f / (1.0f + x + 0.48f * x * x + 0.235f * x * x * x); }
+constexpr float kLn2 = 0.69314718f;
+// One step of a critically damped spring of `halflife` carrying x (rate v) toward goal.
+void damp_toward(float& x, float& v, float goal, float halflife, float dt) {
+    const float y = 2.0f * kLn2 / halflife;
+    const float j0 = x - goal, j1 = v + j0 * y, e = negexp(y * dt);
+    x = e * (j0 + j1 * dt) + goal;
+    v = e * (v - j1 * y * dt);
+}
 }  // namespace
 
 void add_foot_tips(FootPlacementRig& rig, std::span<const int> parents, std::span<const int> end_site_parents,
@@ -89,7 +99,8 @@ void FootPlacementJob::solve_leg(const FootPlacementLeg& leg, vec3 target, quat 
 }
 
 // How far (m) the foot's lowest point (ankle, toe, tip) is below the ground under it; ≤ 0: none is.
-float FootPlacementJob::foot_depth(const FootPlacementLeg& leg) const {
+// `shift` moves every point (the foot's predicted motion).
+float FootPlacementJob::foot_depth(const FootPlacementLeg& leg, vec3 shift) const {
     vec3 points[3];
     int count = 0;
     points[count++] = pose.model_positions[static_cast<size_t>(leg.ankle)];
@@ -100,7 +111,8 @@ float FootPlacementJob::foot_depth(const FootPlacementLeg& leg) const {
     }
     float depth = -1e30f;
     for (int i = 0; i < count; ++i) {
-        const float d = query_ground(*terrain, points[i].x, points[i].z).height - points[i].y;
+        const vec3 q = points[i] + shift;
+        const float d = query_ground(*terrain, q.x, q.z).height - q.y;
         depth = d > depth ? d : depth;
     }
     return depth;
@@ -112,13 +124,59 @@ float FootPlacementJob::foot_depth(const FootPlacementLeg& leg) const {
 bool FootPlacementJob::lift_feet_above_ground(vec3 forward) const {
     bool moved = false;
     for (const FootPlacementLeg& leg : rig->legs) {
-        const float depth = foot_depth(leg);
+        const float depth = smooth_feet ? smooth_lift(state->feet[static_cast<size_t>(&leg - rig->legs.data())], leg)
+                                        : foot_depth(leg, vec3(0.0f));
         if (!(depth > 0.0f)) continue;
         const size_t ankle = static_cast<size_t>(leg.ankle);
         solve_leg(leg, pose.model_positions[ankle] + vec3(0.0f, depth, 0.0f), pose.model_rotations[ankle], forward);
         moved = true;
     }
     return moved;
+}
+
+// smooth_feet's lift of one foot (m, ≥ 0): a spring toward the deepest the
+// foot is now or will be within kLiftLookAheadS at its current velocity, held
+// at least at the depth it is at now.
+float FootPlacementJob::smooth_lift(FootPin& pin, const FootPlacementLeg& leg) const {
+    const vec3 a = pose.model_positions[static_cast<size_t>(leg.ankle)];
+    const bool advance = state->started && dt > 0.0f;
+    const vec3 velocity = advance ? (a - pin.unlifted_previous) / dt : vec3(0.0f);
+    pin.unlifted_previous = a;
+    const float now = foot_depth(leg, vec3(0.0f));
+    float goal = now > 0.0f ? now : 0.0f;
+    for (int k = 1; k <= 3; ++k) {
+        const float ahead = foot_depth(leg, velocity * (kLiftLookAheadS * static_cast<float>(k) / 3.0f));
+        goal = ahead > goal ? ahead : goal;
+    }
+    if (!state->started) pin.lift = goal, pin.lift_velocity = 0.0f;
+    else if (advance) damp_toward(pin.lift, pin.lift_velocity, goal, kLiftHalflifeS, dt);
+    const float floor = now > 0.0f ? now : 0.0f;
+    if (pin.lift < floor) {
+        pin.lift = floor;
+        if (pin.lift_velocity < 0.0f) pin.lift_velocity = 0.0f;
+    }
+    return pin.lift;
+}
+
+// smooth_feet's ankle target: the pin while pinned; else the clip's ankle plus
+// an offset that starts, when the pin lets go, at (pin − clip) with the clip's
+// velocity cancelled, and decays critically damped (halflife release_s / 3).
+vec3 FootPlacementJob::pin_target(FootPin& pin, vec3 free, vec3 clip_velocity, bool let_go) const {
+    if (pin.contact == 1 || !state->started) {
+        pin.release_offset = pin.release_velocity = vec3(0.0f);
+        return pin.contact == 1 ? pin.pin : free;
+    }
+    if (let_go) {
+        pin.release_offset = pin.pin - free;
+        pin.release_velocity = -clip_velocity;
+    }
+    if (dt > 0.0f) {
+        const float halflife = release_s > 0.0f ? release_s / 3.0f : 1e-3f;
+        damp_toward(pin.release_offset.x, pin.release_velocity.x, 0.0f, halflife, dt);
+        damp_toward(pin.release_offset.y, pin.release_velocity.y, 0.0f, halflife, dt);
+        damp_toward(pin.release_offset.z, pin.release_velocity.z, 0.0f, halflife, dt);
+    }
+    return free + pin.release_offset;
 }
 
 bool FootPlacementJob::validate() const {
@@ -143,6 +201,7 @@ bool FootPlacementJob::run() const {
     // up lifts the foot over a few ticks instead of at once.
     GroundSample sample[2];
     bool slow[2];
+    vec3 clip_velocity[2];
     for (int i = 0; i < 2; ++i) {
         FootPin& pin = s.feet[static_cast<size_t>(i)];
         const vec3 a = pose.model_positions[static_cast<size_t>(rig->legs[static_cast<size_t>(i)].ankle)];
@@ -150,6 +209,7 @@ bool FootPlacementJob::run() const {
         const vec3 moved = s.started ? a - pin.clip_previous : vec3(0.0f);
         const float step = std::sqrt(moved.x * moved.x + moved.z * moved.z);
         slow[i] = !(dt > 0.0f) || step <= kPinMaxSpeed * dt;
+        clip_velocity[i] = dt > 0.0f ? moved / dt : vec3(0.0f);
         float wanted = sample[i].height;
         if (step > 1e-6f) {
             const float ahead = max_height_along(*terrain, a.x, a.z, a.x + moved.x / step * kFootLookAheadM,
@@ -180,8 +240,11 @@ bool FootPlacementJob::run() const {
         // The clip's ankle, as high above the ground under it as it was above its flat floor.
         const vec3 free = pose.model_positions[ankle] + vec3(0.0f, pin.ground - s.body_offset, 0.0f);
         const bool contact = ((contacts >> i) & 1u) && slow[i];
+        const bool was_pinned = pin.contact == 1;
+        // smooth_feet lifts after placement, so its pins are where the ankle was placed before the lift.
+        const vec3 placed = smooth_feet && keep_above_ground ? pin.unlifted_previous : pin.placed;
         if (contact && pin.contact == 0) {
-            pin.pin = s.started ? pin.placed : free;
+            pin.pin = s.started ? placed : free;
             pin.contact = 1;
         } else if (!contact && pin.contact != 0) {
             pin.contact = 0;
@@ -191,7 +254,7 @@ bool FootPlacementJob::run() const {
             const float sx = pin.pin.x - free.x, sz = pin.pin.z - free.z;
             if (sx * sx + sz * sz > kMaxPinSlipM * kMaxPinSlipM) {
                 pin.contact = 2;
-                pin.pin = pin.placed;
+                pin.pin = placed;
                 pin.release = 0.0f;
             }
         }
@@ -203,7 +266,8 @@ bool FootPlacementJob::run() const {
         const float plant_step = release_s > 0.0f ? dt / release_s : 1.0f;
         pin.plant = !s.started ? (pin.contact == 1 ? 1.0f : 0.0f)
                                : clamp01(pin.plant + (pin.contact == 1 ? plant_step : -plant_step));
-        const vec3 target = lerp(pin.pin, free, smoothstep(pin.release));
+        const vec3 target = smooth_feet ? pin_target(pin, free, clip_velocity[i], was_pinned && pin.contact != 1)
+                                        : lerp(pin.pin, free, smoothstep(pin.release));
 
         // A planted foot lies on the ground's slope; a lifted one keeps the clip's.
         // (The normal under the target, not under the clip's foot: a pinned foot

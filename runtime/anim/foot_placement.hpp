@@ -35,6 +35,12 @@ struct FootPin {
     float release = 1.0f;        // 0 held at the pin … 1 following the clip's foot
     float plant = 0.0f;          // 0 the clip's foot rotation … 1 tilted to the ground: eased both ways
     std::int32_t contact = 0;    // 0 free, 1 pinned, 2 in contact but let go (the pin slipped too far from the clip)
+    // smooth_feet only (matching), else untouched:
+    vec3 release_offset{0.0f};   // placed − clip's ankle when the pin let go, decaying (critically damped) to 0
+    vec3 release_velocity{0.0f}; // its rate (m/s): starts at −(clip ankle's velocity), so the foot leaves at rest
+    vec3 unlifted_previous{0.0f};// the ankle last tick before the lift: the foot's velocity for the look-ahead
+    float lift = 0.0f;           // metres the foot is raised above its placement, ≥ the depth it would penetrate
+    float lift_velocity = 0.0f;  // its rate (m/s)
 };
 
 struct FootPlacementState {
@@ -79,6 +85,10 @@ inline constexpr float kPinMaxSpeed = 0.35f;
 // adult foot, so the toes clear a riser the ankle has not reached.
 inline constexpr float kFootGroundSpeed = 3.0f;
 inline constexpr float kFootLookAheadM = 0.35f;
+// smooth_feet's lift: how far ahead (s) the foot's penetration is predicted,
+// and the lift spring's halflife (s).
+inline constexpr float kLiftLookAheadS = 0.1f;
+inline constexpr float kLiftHalflifeS = 0.04f;
 
 struct FootPlacementJob {
     FootPlacementState* state = nullptr;
@@ -95,6 +105,14 @@ struct FootPlacementJob {
     // the ground under it is lifted (two-bone IK again, the foot's rotation kept)
     // until its lowest point is on the ground: no point of the foot penetrates.
     bool keep_above_ground = false;
+    // Matching: motions continuous in time instead of the graph's blends. A pin
+    // lets go through an inertialized offset (the ankle starts where and as fast
+    // as it was, then the offset decays critically damped, halflife
+    // release_s / 3) instead of a smoothstep lerp; and keep_above_ground's lift
+    // is a critically damped spring toward the deepest the foot will be within
+    // kLiftLookAheadS at its current velocity (rising before a riser is reached,
+    // falling smoothly after), never below the depth it is at now.
+    bool smooth_feet = false;
 
     // False without a state, rig or terrain, with an invalid rig (a toe or tip
     // joint neither −1 nor a joint included), a negative time
@@ -104,8 +122,10 @@ struct FootPlacementJob {
 
 private:
     void solve_leg(const FootPlacementLeg& leg, vec3 target, quat foot_world, vec3 forward) const;
-    float foot_depth(const FootPlacementLeg& leg) const;
+    float foot_depth(const FootPlacementLeg& leg, vec3 shift) const;
     bool lift_feet_above_ground(vec3 forward) const;
+    float smooth_lift(FootPin& pin, const FootPlacementLeg& leg) const;
+    vec3 pin_target(FootPin& pin, vec3 free, vec3 clip_velocity, bool let_go) const;
 };
 
 }  // namespace marionette

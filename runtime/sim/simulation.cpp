@@ -302,6 +302,7 @@ void Simulation::place_feet(const Pose& clip, float dt, Pose& out, FootPlacement
                                config_.feet_terrain_rate,
                                std::span<const int>(graph_->skeleton.parents),
                                out.spans(n),
+                               keep_above_ground,
                                keep_above_ground};
     expect_job_ran(job.run());
 }
