@@ -7,7 +7,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 start=$(date +%s)
-arm64_packages=(libxxhash-dev:arm64 zlib1g-dev:arm64 libfmt-dev:arm64 libtomlplusplus-dev:arm64 libopenblas-dev:arm64)
+arm64_packages=(libxxhash-dev:arm64 zlib1g-dev:arm64 libfmt-dev:arm64 libtomlplusplus-dev:arm64 libopenblas-dev:arm64 libxml2-dev:arm64)
 host_packages=(g++-aarch64-linux-gnu qemu-user-static catch2 libglm-dev)
 missing=()
 for p in "${arm64_packages[@]}" "${host_packages[@]}"; do
