@@ -225,16 +225,106 @@ float smoothstep01(double x) {
     return static_cast<float>(t * t * (3.0 - 2.0 * t));
 }
 
+// The capture's own jitter in the visible parents of the hidden chains. A solver
+// that fits markers spreads its noise between a joint and its children: when the
+// pelvis or a clavicle wobbles from one frame to the next, the true leg or arm
+// turns the other way in its parent's frame and stays smooth in the world. A fill
+// that is smooth in the parent's frame (a database motion, an interpolation)
+// carries the wobble to the limb's end instead, amplified by its length: that is
+// what the worst border moves of the 4 s gaps were (docs/fill.md). So the graph
+// fill of a chain's top joint is made, and met to the known frames, in a frame
+// that follows the parent's smoothed rotation; the parent's jitter — its model
+// rotation against the smoothed one — is undone on the way back.
+struct ParentJitter {
+    std::vector<int> tops;        // hidden joints whose parent is visible
+    int lo = 0;                   // first frame covered
+    int radius = 1;               // of the smoothing kernel, in the clip's frames
+    std::vector<quat> undo;       // per frame from lo, per top: P(f)⁻¹ · smoothed P(f)
+};
+
+quat model_rotation(const Skeleton& s, const quat* local, int j) {
+    quat r = quat_identity();
+    for (int k = j; k != kNoParent; k = s.parents[static_cast<size_t>(k)]) r = quat_mul(local[k], r);
+    return r;
+}
+
+// model[i]⁻¹ · model smoothed around i (a triangular kernel over ±radius entries,
+// clamped at the sequence's ends): the jitter that moving into the smoothed frame undoes.
+quat smoothing_undo(const std::vector<quat>& model, int i, int radius) {
+    const quat centre = model[static_cast<size_t>(i)];
+    quat sum(0, 0, 0, 0);
+    for (int d = -radius; d <= radius; ++d) {
+        const quat q = model[static_cast<size_t>(std::clamp(i + d, 0, static_cast<int>(model.size()) - 1))];
+        const float w = static_cast<float>(radius + 1 - std::abs(d)) * (quat_dot(q, centre) < 0.0f ? -1.0f : 1.0f);
+        sum = quat(sum.w + w * q.w, sum.x + w * q.x, sum.y + w * q.y, sum.z + w * q.z);
+    }
+    return quat_mul(quat_conjugate(centre), quat_normalize(sum));
+}
+
+ParentJitter parent_jitter(const Clip& c, const std::vector<int>& hidden, int lo, int hi, double smooth_s) {
+    ParentJitter pj;
+    pj.lo = lo;
+    std::vector<bool> is_hidden(static_cast<size_t>(c.joint_count()), false);
+    for (int j : hidden) is_hidden[static_cast<size_t>(j)] = true;
+    for (int j : hidden) {
+        const int p = c.skeleton.parents[static_cast<size_t>(j)];
+        if (p != kNoParent && !is_hidden[static_cast<size_t>(p)]) pj.tops.push_back(j);
+    }
+    pj.radius = std::max(1, static_cast<int>(smooth_s * c.frame_rate + 0.5));
+    const int a = std::max(0, lo - pj.radius), b = std::min(c.frame_count - 1, hi + pj.radius);
+    pj.undo.assign(static_cast<size_t>(hi - lo + 1) * pj.tops.size(), quat_identity());
+    for (size_t t = 0; t < pj.tops.size(); ++t) {
+        const int p = c.skeleton.parents[static_cast<size_t>(pj.tops[t])];
+        std::vector<quat> model(static_cast<size_t>(b - a + 1));
+        for (int f = a; f <= b; ++f) model[static_cast<size_t>(f - a)] = model_rotation(c.skeleton, c.frame_rotations(f), p);
+        for (int f = lo; f <= hi; ++f)
+            pj.undo[static_cast<size_t>(f - lo) * pj.tops.size() + t] = smoothing_undo(model, f - a, pj.radius);
+    }
+    return pj;
+}
+
+// Moves the chain tops' rotations on frames lo..hi into the smoothed parent's
+// frame (`into`) or back into the parent's own frame.
+void apply_parent_jitter(Clip& c, const ParentJitter& pj, bool into) {
+    const size_t n = static_cast<size_t>(c.joint_count());
+    const int frames = pj.tops.empty() ? 0 : static_cast<int>(pj.undo.size() / pj.tops.size());
+    for (int i = 0; i < frames; ++i)
+        for (size_t t = 0; t < pj.tops.size(); ++t) {
+            quat& r = c.rotations[static_cast<size_t>(pj.lo + i) * n + static_cast<size_t>(pj.tops[t])];
+            const quat u = pj.undo[static_cast<size_t>(i) * pj.tops.size() + t];
+            r = quat_normalize(quat_mul(into ? quat_conjugate(u) : u, r));
+        }
+}
+
 // One match's rotations for the hidden joints, offset so they meet the known
 // frames at both borders (the offset slerps from the left border's to the
 // right's across the gap). Frame-major over first..last, hidden joints in order.
 std::vector<quat> matched_rotations(const Clip& clip, const FillGap& g, const FillDatabase& db, const FillMapping& m,
-                                    const std::vector<int>& hidden) {
+                                    const std::vector<int>& hidden, const ParentJitter* pj) {
     const Clip& src = db.clips[static_cast<size_t>(m.match.clip)];
     const size_t n = static_cast<size_t>(clip.joint_count());
     std::vector<quat> r(n);
     std::vector<vec3> t(n);
-    const auto sample = [&](int f) { sample_clip(src, mapped_db_time(m, f / clip.frame_rate), ClipWrap::clamp, r, t); };
+    const auto raw = [&](int f) { sample_clip(src, mapped_db_time(m, f / clip.frame_rate), ClipWrap::clamp, r, t); };
+    // With `pj`, the database motion's chain tops move into its own smoothed
+    // parents' frame too (the same kernel over the same clip frames), so a clip
+    // that truly follows the database still gets its motion back exactly.
+    const size_t tops = pj ? pj->tops.size() : 0;
+    const int fa = pj ? std::max(0, g.first - 1 - pj->radius) : 0;
+    const int fb = pj ? std::min(clip.frame_count - 1, g.last + 1 + pj->radius) : -1;
+    std::vector<std::vector<quat>> parent_model(tops);
+    for (int f = fa; f <= fb && tops > 0; ++f) {
+        raw(f);
+        for (size_t k = 0; k < tops; ++k)
+            parent_model[k].push_back(model_rotation(src.skeleton, r.data(), src.skeleton.parents[static_cast<size_t>(pj->tops[k])]));
+    }
+    const auto sample = [&](int f) {
+        raw(f);
+        for (size_t k = 0; k < tops; ++k) {
+            quat& q = r[static_cast<size_t>(pj->tops[k])];
+            q = quat_normalize(quat_mul(quat_conjugate(smoothing_undo(parent_model[k], f - fa, pj->radius)), q));
+        }
+    };
     const bool before = g.first > 0, after = g.last + 1 < clip.frame_count;
     std::vector<quat> left(hidden.size(), quat_identity()), right(hidden.size(), quat_identity());
     for (int side = 0; side < 2; ++side) {
@@ -261,13 +351,13 @@ std::vector<quat> matched_rotations(const Clip& clip, const FillGap& g, const Fi
 // rotations averaged (weights ∝ 1 / distance; each meets the borders, so their
 // average does), then blended with the baseline for short gaps.
 void apply_graph(Clip& clip, const FillGap& g, const FillDatabase& db, const std::vector<FillMapping>& matches,
-                 const std::vector<int>& hidden, float weight, double ease_s) {
+                 const std::vector<int>& hidden, float weight, double ease_s, const ParentJitter* pj) {
     const size_t n = static_cast<size_t>(clip.joint_count());
     const double best = std::max(matches.front().match.distance, 1e-12);
     std::vector<quat> sum(static_cast<size_t>(g.last - g.first + 1) * hidden.size(), quat(0, 0, 0, 0));
     for (const FillMapping& m : matches) {
         const float w = static_cast<float>(best / std::max(m.match.distance, 1e-12));
-        const std::vector<quat> r = matched_rotations(clip, g, db, m, hidden);
+        const std::vector<quat> r = matched_rotations(clip, g, db, m, hidden, pj);
         for (size_t i = 0; i < r.size(); ++i) {
             const quat q = quat_dot(sum[i], r[i]) < 0.0f ? quat(-r[i].w, -r[i].x, -r[i].y, -r[i].z) : r[i];
             sum[i] = quat(sum[i].w + w * q.w, sum[i].x + w * q.x, sum[i].y + w * q.y, sum[i].z + w * q.z);
@@ -340,7 +430,22 @@ FillMatch fill_gap(Clip& clip, const FillGap& gap, const FillDatabase* db, const
     match = matches.front().match;
     const double gap_s = (gap.last - gap.first + 1) / clip.frame_rate;
     match.graph_weight = o.interp_blend_s > 0.0 ? smoothstep01(gap_s / o.interp_blend_s) : 1.0;
-    apply_graph(clip, gap, *db, matches, hidden, static_cast<float>(match.graph_weight), o.ease_s);
+    if (o.parent_smooth_s <= 0.0) {
+        apply_graph(clip, gap, *db, matches, hidden, static_cast<float>(match.graph_weight), o.ease_s, nullptr);
+        return match;
+    }
+    // Fill in the smoothed parents' frame (the borders, the ease's known frames
+    // and the slerp baseline with it), then move the gap's frames back; frames
+    // outside the gap are not written, so they stay bit for bit.
+    const int lo = std::max(0, gap.first - 5), hi = std::min(clip.frame_count - 1, gap.last + 5);
+    const ParentJitter pj = parent_jitter(clip, hidden, lo, hi, o.parent_smooth_s);
+    Clip work = clip;
+    apply_parent_jitter(work, pj, true);
+    apply_graph(work, gap, *db, matches, hidden, static_cast<float>(match.graph_weight), o.ease_s, &pj);
+    apply_parent_jitter(work, pj, false);
+    for (int f = gap.first; f <= gap.last; ++f)
+        for (int j : hidden)
+            clip.rotations[static_cast<size_t>(f) * n + static_cast<size_t>(j)] = work.rotations[static_cast<size_t>(f) * n + static_cast<size_t>(j)];
     return match;
 }
 

@@ -71,6 +71,11 @@ struct FillOptions {
     // frame's point cloud: compares the root's velocity in the body's frame, which
     // the per-frame alignment otherwise discards (docs/fill.md).
     double velocity_weight = 10.0;
+    // Half-width (s) of the smoothing of the hidden chains' visible parents: the
+    // graph fill of a chain's top joint follows the parent's smoothed rotation, so
+    // the capture's frame-to-frame jitter of a pelvis or clavicle does not reach the
+    // filled limb (docs/fill.md). 0: fill in the parent's own frame.
+    double parent_smooth_s = 0.05;
     // Evaluation only (`fill-eval --oracle-match`): the search also sees the hidden
     // joints' values inside the gap — which the clip must still hold (the truth) —
     // so the match is the best in hindsight. Separates a wrong match from what

@@ -125,6 +125,43 @@ TEST_CASE("fill: a hidden leg that truly follows a database clip is recovered al
     }
 }
 
+// The cause of the worst border moves at 4 s (docs/fill.md): a capture whose
+// visible parent jitters from frame to frame while the hidden limb, truly smooth
+// in the world, turns the other way in the parent's frame. The graph fill follows
+// the parent's smoothed rotation, so it keeps the limb smooth as the truth does;
+// filled in the parent's own frame it carried the jitter to the hand.
+TEST_CASE("fill: a visible parent's frame-to-frame jitter does not reach the filled limb", "[fill]") {
+    const FillDatabase db = prepare_fill_database({walker_clip("db", 0.0, 400)});
+    Clip truth = walker_clip("input", 2.3, 150);
+    const int n = truth.joint_count();
+    for (double amplitude : {0.04, 0.08, 0.15}) {
+        for (int f = 0; f < truth.frame_count; ++f) {
+            // The spine (1) wobbles, alternating each frame; its children (the upper
+            // arms 2 and 4) counter-rotate, so their model rotations do not change.
+            const quat jitter = quat_axis_angle(vec3(0, 0, 1), static_cast<float>(f % 2 ? amplitude : -amplitude));
+            quat* r = truth.rotations.data() + static_cast<size_t>(f) * static_cast<size_t>(n);
+            r[1] = quat_mul(r[1], jitter);
+            r[2] = quat_mul(quat_conjugate(jitter), r[2]);
+            r[4] = quat_mul(quat_conjugate(jitter), r[4]);
+        }
+        FillGap g;
+        g.hidden = resolve_hidden_joints(truth.skeleton, "arms", "--hide");
+        g.first = 40;
+        g.last = 99;
+        FillOptions smoothed, own;
+        smoothed.ease_s = own.ease_s = 0.0;  // the border ease's own flaw (docs/fill.md) aside
+        own.parent_smooth_s = 0.0;
+        Clip a = truth, b = truth;
+        (void)fill_gap(a, g, &db, smoothed);
+        (void)fill_gap(b, g, &db, own);
+        const double with = max_error(a, truth, 0, truth.frame_count - 1), without = max_error(b, truth, 0, truth.frame_count - 1);
+        INFO("jitter " << amplitude << " rad: worst error " << with << " following the smoothed parent, " << without << " in its own frame");
+        CHECK(with < 0.15 * without);  // 0.11 today: the kernel leaves a ninth of an alternating jitter
+        CHECK(visible_identical(truth, a, g));
+        truth = walker_clip("input", 2.3, 150);
+    }
+}
+
 TEST_CASE("fill: every method leaves visible joints and frames outside the gap bit for bit", "[fill]") {
     const FillDatabase db = prepare_fill_database({walker_clip("db", 0.0, 300, 1.15), walker_clip("db2", 1.0, 200, 0.9)});
     const Clip truth = walker_clip("input", 0.37, 180);
@@ -258,20 +295,26 @@ void check_targets(const char* group, const std::vector<double>& gaps, int trial
 }  // namespace
 
 // On the shared CMU subject-16 clips, leave-one-out, 2 gaps per clip and length
-// (docs/fill.md has the full table): what holds today. One leg and both legs meet
-// the issue's target at 1 and 2 s (graph ≤ ½ slerp); both arms beat slerp at every
-// length but not by half (docs/fill.md, "Where it stands").
+// (docs/fill.md has the full table): what holds today. One leg meets all the
+// issue's targets; both legs meet the half-error target at 1 and 2 s (graph ≤ ½
+// slerp); both arms beat slerp at every length but not by half (docs/fill.md,
+// "Where it stands"). The worst border ratio is ≤ 2 for all three here.
 TEST_CASE("fill: on the CMU subject-16 clips graph beats slerp; legs meet the half-error target at 1 and 2 s", "[fill]") {
     if (test::mocap_dir().empty()) return;  // skipped without the shared data (fails under CI=true)
-    check_targets("left_leg", {0.25, 1.0, 2.0}, 2, true, true);
-    check_targets("legs", {0.25, 1.0, 2.0}, 2, true, false);  // met at 1 and 2 s since the root-velocity point
-    check_targets("arms", {0.25, 1.0, 2.0}, 2, false, false);  // worst border ratio 3.4 at 1 s (docs/fill.md)
+    // One leg meets every target of the issue, as written (every length, 3 gaps per
+    // clip and length, the worst border ratio ≤ 2 at 4 s since the fill follows
+    // the smoothed parent), so it is checked here rather than in "[.fill-targets]".
+    check_targets("left_leg", {0.25, 0.5, 1.0, 2.0, 4.0}, 3, true, true);
+    check_targets("legs", {0.25, 1.0, 2.0}, 2, true, true);  // met at 1 and 2 s since the root-velocity point
+    check_targets("arms", {0.25, 1.0, 2.0}, 2, false, true);
 }
 
 // The issue's targets as written, for every group and gap length (hidden: run with
-// `marionette_graph_tests "[.fill-targets]"`; legs and arms miss the half-error
-// target today, docs/fill.md).
+// `marionette_graph_tests "[.fill-targets]"`; legs miss the half-error target at
+// 4 s and arms at 1, 2 and 4 s, and arms the worst border ratio at 4 s (2.16,
+// where the truth's own move is 2.08), docs/fill.md).
 TEST_CASE("fill: the issue's targets for legs, arms and one leg at every gap length", "[.fill-targets]") {
     if (test::mocap_dir().empty()) return;  // skipped without the shared data (fails under CI=true)
-    for (const char* group : {"legs", "arms", "left_leg"}) check_targets(group, {0.25, 0.5, 1.0, 2.0, 4.0}, 3, true, true);
+    // One leg meets them all: its check is in the CI test above.
+    for (const char* group : {"legs", "arms"}) check_targets(group, {0.25, 0.5, 1.0, 2.0, 4.0}, 3, true, true);
 }
