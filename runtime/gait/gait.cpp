@@ -469,6 +469,7 @@ struct GaitTick {
     SteerGoal goal;         // the stick's ask (speed 0: released), for the path prediction
     float target_speed;     // what the speed moved toward this tick
     const NearbyWalls& walls;
+    float stick_fraction;   // the stick's speed fraction (0: released), for ground_speed along the prediction
 };
 
 // What the steering law and the step clock will do if the stick holds: where
@@ -485,6 +486,13 @@ constexpr float kMaxTurnPerStepDeg = 90.0f;  // most a foot turns in one swing
 constexpr float kMaxFootTurnDegS = 300.0f;   // … and on average per second of the swing
 // Radians a foot may turn in a swing landing in `seconds`.
 double max_foot_turn(float seconds) { return minf(kMaxTurnPerStepDeg, kMaxFootTurnDegS * seconds) * det::kDegToRad; }
+// Seconds a timed swing (a stop, a closing step) takes at least, so that its
+// foot turns from `from` to `to` at no more than kMaxFootTurnDegS on average:
+// held to stop_transition_s, a foot turned 100–175° in 0.15–0.3 s and the foot
+// joint passed 1500 °/s (sweep cases 1-0071, 1-0136, 7-0012, 7-0289 ...).
+float turn_time(quat from, quat to) {
+    return static_cast<float>(quat_angle_between(from, to) * det::kRadToDeg) / kMaxFootTurnDegS;
+}
 
 // Runs the tick's own steering law (steer_root: turns, braking, walls) and step
 // clock forward tick by tick from this tick's root until the foot's phase
@@ -496,8 +504,18 @@ PathPrediction predict_path(const GaitState& g, const GaitTick& t, vec3 root, fl
     float phase_left = remaining_phase;
     float target = t.target_speed;
     int k = 0;
+    // The stick's speed is asked of the ground where the root will be (the
+    // slope factor and climb cap ahead, as steer() will ask it each tick):
+    // predicted with today's speed, a run reaching a flight planned its step
+    // for 3 m/s while the root slowed to 0.9 m/s on the stairs, and the swing
+    // spanned four treads (building stairs × run, a 1.1 m lunge 72 cm down).
+    SteerGoal goal = t.goal;
+    const auto ask_ground = [&] {
+        if (goal.speed > 0.0f) goal.speed = ground_speed(t.terrain, t.c, t.stick_fraction, m.x, m.z, m.heading);
+    };
     for (; k < kMaxPredictedTicks && phase_left > 0.0f; ++k) {
-        if (t.goal.speed > 0.0f) target = steer_root(m, t.goal, t.walls, t.c, t.dt).target_speed;
+        ask_ground();
+        if (t.goal.speed > 0.0f) target = steer_root(m, goal, t.walls, t.c, t.dt).target_speed;
         phase_left -= t.dt / (2.0f * step_plan(t.c, m.speed, target, m.turning_in_place != 0).duration);
         out.time += t.dt;
     }
@@ -505,7 +523,8 @@ PathPrediction predict_path(const GaitState& g, const GaitTick& t, vec3 root, fl
     const StepPlan next = step_plan(t.c, m.speed, target, m.turning_in_place != 0);
     float stance_left = next.duty * next.duration;  // half of duty · 2 · duration
     for (; k < kMaxPredictedTicks && stance_left > 0.0f; ++k) {
-        if (t.goal.speed > 0.0f) steer_root(m, t.goal, t.walls, t.c, t.dt);
+        ask_ground();
+        if (t.goal.speed > 0.0f) steer_root(m, goal, t.walls, t.c, t.dt);
         stance_left -= t.dt;
     }
     out.mid_stance = m;
@@ -533,6 +552,7 @@ Placement plan_target(const GaitState& g, const GaitTick& t, int foot, vec3 root
 }
 
 constexpr float kShortestSwing = 0.12f;           // s: a late lift-off still swings this long
+constexpr float kMaxMeanSwingSpeed = 4.0f;        // m/s: … and at least its travel over this
 constexpr float kWristDrag = 0.4f;                // hand tilt against its path's velocity, per m/cycle
 constexpr float kMaxPelvisVerticalSpeed = 0.9f;   // m/s the pelvis follows its height target at, at most
 
@@ -782,9 +802,11 @@ void start_stopping(GaitState& g, const GaitTick& t, vec3 root) {
         const vec3 spot = root + t.h.left * (side_sign(i) * t.rig.hip_half_width);
         const Placement p = other.swinging ? place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, t.h.forward)
                                            : stop_target(g, i, t.heading, t.rig, t.terrain);
-        // Short, but never faster than kMaxStopFootSpeed for the foot.
-        const float time = clampf(maxf(remaining, horizontal_distance(f.ankle, p.ankle) / kMaxStopFootSpeed), kMinStopSwingS,
-                                  t.c.stop_transition_s);
+        // Short, but never faster than kMaxStopFootSpeed for the foot, nor
+        // turning faster than kMaxFootTurnDegS on average.
+        const float time = maxf(clampf(maxf(remaining, horizontal_distance(f.ankle, p.ankle) / kMaxStopFootSpeed), kMinStopSwingS,
+                                       t.c.stop_transition_s),
+                                turn_time(f.rotation, p.rotation));
         begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, 0.0f, 1.0f / time);
     }
 }
@@ -814,12 +836,18 @@ Placement aim_swing(const GaitState& g, const GaitTick& t, vec3 root, int i, flo
     return place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, heading_frame(facing).forward);
 }
 
+// The shortest a phase-driven swing may take: kShortestSwing, and its travel
+// at kMaxMeanSwingSpeed. A foot lifting (or re-aimed) late in its phase had the
+// cycle's few remaining hundredths of a second for up to 0.9 m: its shin passed
+// 1500 °/s (wall × reversals after a long stop swing, 1506 °/s).
+float shortest_swing(const FootState& f, const GaitRig& rig) { return maxf(kShortestSwing, swing_travel(f, rig) / kMaxMeanSwingSpeed); }
+
 // The swing's progress per second: at its own rate after a stop, else with the
 // cycle's phase (over what was left of it at lift-off), but never slower than a
 // kShortestSwing swing.
 float swing_rate(const FootState& f, const GaitTick& t) {
     return f.timed_rate > 0.0f ? f.timed_rate
-                               : minf(t.dphase / t.dt / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), 1.0f / kShortestSwing);
+                               : minf(t.dphase / t.dt / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), 1.0f / shortest_swing(f, t.rig));
 }
 
 // Where a swing's hip will be when it lands, if the root keeps its speed and heading.
@@ -867,7 +895,7 @@ void advance_swing(GaitState& g, const GaitTick& t, vec3 root, int i) {
     FootState& f = g.feet[static_cast<std::size_t>(i)];
     const float rate = f.timed_rate > 0.0f
                            ? f.timed_rate * t.dt
-                           : minf(t.dphase / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), t.dt / kShortestSwing);
+                           : minf(t.dphase / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), t.dt / shortest_swing(f, t.rig));
     f.progress += rate;
     if (f.progress >= 1.0f) {
         land(f, g);
@@ -922,8 +950,8 @@ void finish_stopping(GaitState& g, const GaitTick& t) {
         const int trailing = along < 0.0f ? 0 : 1;
         FootState& f = g.feet[static_cast<std::size_t>(trailing)];
         const Placement p = stop_target(g, trailing, t.heading, t.rig, t.terrain);
-        begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, 0.0f,
-                    1.0f / maxf(kMinClosingStepS, t.c.stop_transition_s * kClosingStepStretch));
+        const float time = maxf(maxf(kMinClosingStepS, t.c.stop_transition_s * kClosingStepStretch), turn_time(f.rotation, p.rotation));
+        begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, 0.0f, 1.0f / time);
         evaluate_swing(f, trailing, t.c, t.rig, g.run_blend, t.h.left);
     } else {
         g.mode = GaitMode::idle;
@@ -1073,7 +1101,7 @@ void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const
     const bool wants_steps = cmd.moving && (g.speed > 0.0f || g.turning_in_place || abs_diff > kStepTurnRad);
     const StepPlan plan = step_plan(c, g.speed, s.result.target_speed, g.turning_in_place != 0);
     const GaitTick t{c,    rig,  terrain, dt, heading, s.result.heading, h, plan, dt / (kStepsPerCycle * plan.duration),
-                     s.goal, s.result.target_speed, walls};
+                     s.goal, s.result.target_speed, walls, cmd.moving ? cmd.fraction : 0.0f};
     change_mode(g, t, root, wants_steps, s.result.diff);
     advance_feet(g, t, root);
     finish_stopping(g, t);
