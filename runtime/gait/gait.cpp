@@ -469,7 +469,6 @@ struct GaitTick {
     SteerGoal goal;         // the stick's ask (speed 0: released), for the path prediction
     float target_speed;     // what the speed moved toward this tick
     const NearbyWalls& walls;
-    float stick_fraction;   // the stick's speed fraction (0: released), for ground_speed along the prediction
 };
 
 // What the steering law and the step clock will do if the stick holds: where
@@ -504,18 +503,8 @@ PathPrediction predict_path(const GaitState& g, const GaitTick& t, vec3 root, fl
     float phase_left = remaining_phase;
     float target = t.target_speed;
     int k = 0;
-    // The stick's speed is asked of the ground where the root will be (the
-    // slope factor and climb cap ahead, as steer() will ask it each tick):
-    // predicted with today's speed, a run reaching a flight planned its step
-    // for 3 m/s while the root slowed to 0.9 m/s on the stairs, and the swing
-    // spanned four treads (building stairs × run, a 1.1 m lunge 72 cm down).
-    SteerGoal goal = t.goal;
-    const auto ask_ground = [&] {
-        if (goal.speed > 0.0f) goal.speed = ground_speed(t.terrain, t.c, t.stick_fraction, m.x, m.z, m.heading);
-    };
     for (; k < kMaxPredictedTicks && phase_left > 0.0f; ++k) {
-        ask_ground();
-        if (t.goal.speed > 0.0f) target = steer_root(m, goal, t.walls, t.c, t.dt).target_speed;
+        if (t.goal.speed > 0.0f) target = steer_root(m, t.goal, t.walls, t.c, t.dt).target_speed;
         phase_left -= t.dt / (2.0f * step_plan(t.c, m.speed, target, m.turning_in_place != 0).duration);
         out.time += t.dt;
     }
@@ -523,8 +512,7 @@ PathPrediction predict_path(const GaitState& g, const GaitTick& t, vec3 root, fl
     const StepPlan next = step_plan(t.c, m.speed, target, m.turning_in_place != 0);
     float stance_left = next.duty * next.duration;  // half of duty · 2 · duration
     for (; k < kMaxPredictedTicks && stance_left > 0.0f; ++k) {
-        ask_ground();
-        if (t.goal.speed > 0.0f) steer_root(m, goal, t.walls, t.c, t.dt);
+        if (t.goal.speed > 0.0f) steer_root(m, t.goal, t.walls, t.c, t.dt);
         stance_left -= t.dt;
     }
     out.mid_stance = m;
@@ -1129,7 +1117,7 @@ void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const
     const bool wants_steps = cmd.moving && (g.speed > 0.0f || g.turning_in_place || abs_diff > kStepTurnRad);
     const StepPlan plan = step_plan(c, g.speed, s.result.target_speed, g.turning_in_place != 0);
     const GaitTick t{c,    rig,  terrain, dt, heading, s.result.heading, h, plan, dt / (kStepsPerCycle * plan.duration),
-                     s.goal, s.result.target_speed, walls, cmd.moving ? cmd.fraction : 0.0f};
+                     s.goal, s.result.target_speed, walls};
     change_mode(g, t, root, wants_steps, s.result.diff);
     advance_feet(g, t, root);
     finish_stopping(g, t);

@@ -195,15 +195,12 @@ struct KnownFailure {
     Ground kind;
     std::uint64_t seed;
 };
-// Stairs seeds 6 and 40 (1653 °/s, a late-lifted swing with the cycle's last
-// hundredths of a second for its travel) meet every limit since a swing takes
-// at least its travel at 4 m/s (branch gait3) and are kept as regressions, as
-// the 14 other stairs seeds and curb seed 74 are since the pelvis sinks in time
-// for a landing. Heightfield seed 56 fails since the path prediction asks
-// ground_speed() (branch gait4, docs/gait.md): the right swing is found
-// stranded and re-aimed 24 times in 2.8 s while the planted left foot holds
-// the root back, and the root stalls (speed error 96.9 %; 0.08 % without it).
-constexpr KnownFailure kKnownFailures[] = {{Ground::heightfield, 56}};
+// None now: stairs seeds 6 and 40 (1653 °/s, a late-lifted swing with the
+// cycle's last hundredths of a second for its travel) meet every limit since a
+// swing takes at least its travel at 4 m/s (branch gait3) and are kept as
+// regressions, as the 14 other stairs seeds and curb seed 74 are since the
+// pelvis sinks in time for a landing.
+constexpr std::array<KnownFailure, 0> kKnownFailures{};
 bool known_failure(Ground kind, std::uint64_t seed) {
     for (const KnownFailure& k : kKnownFailures)
         if (k.kind == kind && k.seed == seed) return true;
