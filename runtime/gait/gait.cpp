@@ -485,6 +485,13 @@ constexpr float kMaxTurnPerStepDeg = 90.0f;  // most a foot turns in one swing
 constexpr float kMaxFootTurnDegS = 300.0f;   // … and on average per second of the swing
 // Radians a foot may turn in a swing landing in `seconds`.
 double max_foot_turn(float seconds) { return minf(kMaxTurnPerStepDeg, kMaxFootTurnDegS * seconds) * det::kDegToRad; }
+// Seconds a timed swing (a stop, a closing step) takes at least, so that its
+// foot turns from `from` to `to` at no more than kMaxFootTurnDegS on average:
+// held to stop_transition_s, a foot turned 100–175° in 0.15–0.3 s and the foot
+// joint passed 1500 °/s (sweep cases 1-0071, 1-0136, 7-0012, 7-0289 ...).
+float turn_time(quat from, quat to) {
+    return static_cast<float>(quat_angle_between(from, to) * det::kRadToDeg) / kMaxFootTurnDegS;
+}
 
 // Runs the tick's own steering law (steer_root: turns, braking, walls) and step
 // clock forward tick by tick from this tick's root until the foot's phase
@@ -533,6 +540,7 @@ Placement plan_target(const GaitState& g, const GaitTick& t, int foot, vec3 root
 }
 
 constexpr float kShortestSwing = 0.12f;           // s: a late lift-off still swings this long
+constexpr float kMaxMeanSwingSpeed = 4.0f;        // m/s: … and at least its travel over this
 constexpr float kWristDrag = 0.4f;                // hand tilt against its path's velocity, per m/cycle
 constexpr float kMaxPelvisVerticalSpeed = 0.9f;   // m/s the pelvis follows its height target at, at most
 
@@ -782,9 +790,11 @@ void start_stopping(GaitState& g, const GaitTick& t, vec3 root) {
         const vec3 spot = root + t.h.left * (side_sign(i) * t.rig.hip_half_width);
         const Placement p = other.swinging ? place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, t.h.forward)
                                            : stop_target(g, i, t.heading, t.rig, t.terrain);
-        // Short, but never faster than kMaxStopFootSpeed for the foot.
-        const float time = clampf(maxf(remaining, horizontal_distance(f.ankle, p.ankle) / kMaxStopFootSpeed), kMinStopSwingS,
-                                  t.c.stop_transition_s);
+        // Short, but never faster than kMaxStopFootSpeed for the foot, nor
+        // turning faster than kMaxFootTurnDegS on average.
+        const float time = maxf(clampf(maxf(remaining, horizontal_distance(f.ankle, p.ankle) / kMaxStopFootSpeed), kMinStopSwingS,
+                                       t.c.stop_transition_s),
+                                turn_time(f.rotation, p.rotation));
         begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, 0.0f, 1.0f / time);
     }
 }
@@ -794,12 +804,13 @@ void change_mode(GaitState& g, const GaitTick& t, vec3 root, bool wants_steps, d
     else if (!wants_steps && g.mode == GaitMode::stepping) start_stopping(g, t, root);
 }
 
-// Where foot i, lifting (or re-aiming) at its phase psi, should land.
-Placement aim_swing(const GaitState& g, const GaitTick& t, vec3 root, int i, float psi) {
+// Where foot i, lifting (or re-aiming) with `remaining` of the cycle's phase
+// until it lands, should land.
+Placement aim_swing(const GaitState& g, const GaitTick& t, vec3 root, int i, float remaining) {
     if (!g.turning_in_place)
-        return plan_target(g, t, i, root, 1.0f - psi);
+        return plan_target(g, t, i, root, remaining);
     // Turning in place: small steps to the hip's spot under the turned heading.
-    const float time_to_land = predict_path(g, t, root, 1.0f - psi).time;
+    const float time_to_land = predict_path(g, t, root, remaining).time;
     const double turn = det::wrap_angle(static_cast<double>(t.desired_heading) - t.heading);
     // Small steps: a foot turns at most kMaxTurnPerStepDeg per swing.
     const double max_turn = minf(minf(t.c.turn_rate_deg_s, kMaxFootTurnDegS) * time_to_land, kMaxTurnPerStepDeg) * det::kDegToRad;
@@ -814,12 +825,45 @@ Placement aim_swing(const GaitState& g, const GaitTick& t, vec3 root, int i, flo
     return place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, heading_frame(facing).forward);
 }
 
+// The shortest a phase-driven swing may take: kShortestSwing, and its travel
+// at kMaxMeanSwingSpeed. A foot lifting (or re-aimed) late in its phase had the
+// cycle's few remaining hundredths of a second for up to 0.9 m: its shin passed
+// 1500 °/s (wall × reversals after a long stop swing, 1506 °/s).
+float shortest_swing(const FootState& f, const GaitRig& rig) { return maxf(kShortestSwing, swing_travel(f, rig) / kMaxMeanSwingSpeed); }
+
+// Starts (or re-aims) foot i's phase-driven swing at its phase psi, aimed for
+// the time it will take. A swing held to its travel at kMaxMeanSwingSpeed
+// outlasts the phase left when an ordinary swing already moves near 4 m/s (a
+// run near 1.9 m/s): aimed for the phase's time, it landed behind the root, was
+// flagged stranded and re-aimed over and over (the spun-stick test's case 27,
+// foot_l 5,358 °/s). It is aimed again for its own, longer time then.
+void begin_aimed_swing(GaitState& g, const GaitTick& t, vec3 root, int i, float psi) {
+    FootState& f = g.feet[static_cast<std::size_t>(i)];
+    const float remaining = 1.0f - psi;
+    begin_swing(f, aim_swing(g, t, root, i, remaining), t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
+    if (!(t.dphase > 0.0f)) return;
+    const float phase_time = maxf(kMinSwingPhaseShare, remaining) * t.dt / t.dphase;
+    const float swing_time = shortest_swing(f, t.rig);
+    if (swing_time > phase_time)
+        begin_swing(f, aim_swing(g, t, root, i, swing_time * t.dphase / t.dt), t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
+}
+
+// The foot's phase for a re-aim. A swing that outlasts its phase (held to its
+// travel at kMaxMeanSwingSpeed) sees the foot's phase wrap past 1 to near 0:
+// re-aimed with that, a whole cycle was left to land in, the spot lay a cycle
+// ahead, and the swing was stranded again (8 re-aims in 0.85 s, case 27). After
+// the wrap it keeps its lift phase.
+float swing_phase_now(const FootState& f, float cycle_phase, int i) {
+    const float psi = foot_phase(cycle_phase, i);
+    return psi < f.lift_phase ? f.lift_phase : psi;
+}
+
 // The swing's progress per second: at its own rate after a stop, else with the
 // cycle's phase (over what was left of it at lift-off), but never slower than a
 // kShortestSwing swing.
 float swing_rate(const FootState& f, const GaitTick& t) {
     return f.timed_rate > 0.0f ? f.timed_rate
-                               : minf(t.dphase / t.dt / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), 1.0f / kShortestSwing);
+                               : minf(t.dphase / t.dt / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), 1.0f / shortest_swing(f, t.rig));
 }
 
 // Where a swing's hip will be when it lands, if the root keeps its speed and heading.
@@ -847,12 +891,12 @@ void reaim_if_command_changed(GaitState& g, const GaitTick& t, vec3 root, int i)
     const bool may_reaim =
         stepping && ((command_changed && f.replanned < kMaxReaims && f.progress < kLatestReaimProgress) || stranded);
     if (!may_reaim) return;
-    const float psi = foot_phase(g.cycle_phase, i);
-    const Placement p = aim_swing(g, t, root, i, psi);
+    const float psi = swing_phase_now(f, g.cycle_phase, i);
+    const Placement p = aim_swing(g, t, root, i, 1.0f - psi);
     const bool closer = !stranded || horizontal_distance(p.ankle, hip_then) < gap - kMinReaimShiftM;
     if (closer && horizontal_distance(p.ankle, f.target) > kMinReaimShiftM) {
         const float ground = f.ground;
-        begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
+        begin_aimed_swing(g, t, root, i, psi);
         f.start_ground = ground;
         ++f.replanned;
     }
@@ -867,7 +911,7 @@ void advance_swing(GaitState& g, const GaitTick& t, vec3 root, int i) {
     FootState& f = g.feet[static_cast<std::size_t>(i)];
     const float rate = f.timed_rate > 0.0f
                            ? f.timed_rate * t.dt
-                           : minf(t.dphase / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), t.dt / kShortestSwing);
+                           : minf(t.dphase / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), t.dt / shortest_swing(f, t.rig));
     f.progress += rate;
     if (f.progress >= 1.0f) {
         land(f, g);
@@ -894,7 +938,7 @@ void lift_if_due(GaitState& g, const GaitTick& t, vec3 root, int i) {
     const bool left_behind = !other.swinging && psi >= t.plan.duty - kEarlyLiftPhase &&
                              (behind > kEarlyLiftReachShare * t.rig.leg_reach || behind > kEarlyLiftStanceShare * kStanceReachM);
     if ((psi >= t.plan.duty && (!walking || !other.swinging)) || left_behind) {
-        begin_swing(f, aim_swing(g, t, root, i, psi), t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
+        begin_aimed_swing(g, t, root, i, psi);
         f.planned_speed = g.commanded_speed;
         f.planned_heading = t.desired_heading;
         evaluate_swing(f, i, t.c, t.rig, g.run_blend, t.h.left);
@@ -922,8 +966,8 @@ void finish_stopping(GaitState& g, const GaitTick& t) {
         const int trailing = along < 0.0f ? 0 : 1;
         FootState& f = g.feet[static_cast<std::size_t>(trailing)];
         const Placement p = stop_target(g, trailing, t.heading, t.rig, t.terrain);
-        begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, 0.0f,
-                    1.0f / maxf(kMinClosingStepS, t.c.stop_transition_s * kClosingStepStretch));
+        const float time = maxf(maxf(kMinClosingStepS, t.c.stop_transition_s * kClosingStepStretch), turn_time(f.rotation, p.rotation));
+        begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, 0.0f, 1.0f / time);
         evaluate_swing(f, trailing, t.c, t.rig, g.run_blend, t.h.left);
     } else {
         g.mode = GaitMode::idle;

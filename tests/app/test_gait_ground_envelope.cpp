@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <initializer_list>
@@ -194,11 +195,12 @@ struct KnownFailure {
     Ground kind;
     std::uint64_t seed;
 };
-constexpr KnownFailure kKnownFailures[] = {
-    // stairs (the other 14 stairs seeds and curb seed 74 meet every limit since
-    // the pelvis sinks in time for a landing, and are kept as regressions)
-    {Ground::stairs, 6}, {Ground::stairs, 40},
-};
+// None now: stairs seeds 6 and 40 (1653 °/s, a late-lifted swing with the
+// cycle's last hundredths of a second for its travel) meet every limit since a
+// swing takes at least its travel at 4 m/s (branch gait3) and are kept as
+// regressions, as the 14 other stairs seeds and curb seed 74 are since the
+// pelvis sinks in time for a landing.
+constexpr std::array<KnownFailure, 0> kKnownFailures{};
 bool known_failure(Ground kind, std::uint64_t seed) {
     for (const KnownFailure& k : kKnownFailures)
         if (k.kind == kind && k.seed == seed) return true;
@@ -229,7 +231,7 @@ void check_kind(Ground kind, const char* name, std::initializer_list<std::uint64
 }  // namespace
 
 TEST_CASE("gait ground envelope: generated stairs, up and down, at any angle to 60 degrees", "[gait_ground]") {
-    check_kind(Ground::stairs, "stairs", {37, 52, 4, 10, 11, 13, 15, 21, 27, 44, 54, 78, 86, 89, 93, 95});
+    check_kind(Ground::stairs, "stairs", {37, 52, 4, 10, 11, 13, 15, 21, 27, 44, 54, 78, 86, 89, 93, 95, 6, 40});
 }
 
 TEST_CASE("gait ground envelope: generated ramps and hillsides to 30 degrees, at any heading", "[gait_ground]") {

@@ -27,7 +27,7 @@ if [[ $mode == all ]]; then
   programs=$(cd "$src/config/programs" && ls *.prog | sed 's/\.prog$//')
 elif [[ $mode == stairs ]]; then
   terrains="building_stairs"
-  programs="circle reversals start_stop"   # demo: 1420 °/s on branch gaitstairs, 1602 after the merge with gaitsweep (docs/gait.md)
+  programs="circle reversals start_stop actions demo full_circle"   # the last three: 1513, 1602, 1527 °/s before branch gait3 (docs/gait.md)
 else
   terrains="flat stairs slope rubble"
   programs="slow_walk fast_walk run start_stop full_circle reversals stop_mid_step"
