@@ -35,6 +35,13 @@ void phase_range(const SplinePrototype& p, int index, float& lo, float& hi) {
     hi = std::max(p.keys[static_cast<std::size_t>(index + 1)].phase - kMinKeyGap, cur);
 }
 
+// A changed value on the 1e-4 grid, so saved files read 0.21, not 0.21000001
+// (0.2 + 0.01 in float); an unchanged one exactly as it was.
+float quantized(float value, float current) {
+    if (value == current) return current;
+    return std::round(value * kSplineQuantum) / kSplineQuantum;
+}
+
 }  // namespace
 
 const char* gait_table(SplineGait gait) { return gait == SplineGait::walk ? "gait.walk" : "gait.run"; }
@@ -67,11 +74,12 @@ bool set_key(SplinePrototype& p, SplinePath path, int index, float phase, int ch
     if (phase_editable(p, index)) {
         float lo = 0.0f, hi = 0.0f;
         phase_range(p, index, lo, hi);
-        k.phase = std::clamp(phase, lo, hi);
+        k.phase = std::clamp(quantized(phase, k.phase), lo, hi);
     }
     if (values_editable(p, path, index)) {
         const float cur = channel_of(k, channel);
-        const float v = std::clamp(value, std::min(-kSplineValueLimit, cur), std::max(kSplineValueLimit, cur));
+        const float v =
+            std::clamp(quantized(value, cur), std::min(-kSplineValueLimit, cur), std::max(kSplineValueLimit, cur));
         channel_of(k, channel) = v;
         // A looping path's ends are one point: both move.
         if (path_loops(path) && (index == 0 || index == p.count - 1)) {

@@ -20,6 +20,7 @@ inline constexpr float kMinKeyGap = 0.02f;          // phase between neighbourin
 inline constexpr float kSplineValueLimit = 1.0f;    // |x|, |y|, |z| an edit leaves (files allow ±10)
 inline constexpr float kSplinePhaseStep = 0.01f;    // phase per pad step
 inline constexpr float kSplineValueStep = 0.005f;   // value per pad step (m; the swing's z: fraction)
+inline constexpr float kSplineQuantum = 1.0e4f;     // an edited phase or value lands on a multiple of 1/this
 
 const char* gait_table(SplineGait gait);  // "gait.walk", "gait.run"
 const char* path_key(SplinePath path);    // "swing_foot", "pelvis", "hand"
@@ -38,6 +39,7 @@ bool values_editable(const SplinePrototype& p, SplinePath path, int index);
 // a delta is not finite, or the clamped key equals the old one.
 bool move_key(SplinePrototype& p, SplinePath path, int index, float dphase, int channel, float dvalue);
 // The same to an absolute phase and value (a mouse drag), clamped likewise.
+// A phase or value that changes is rounded to a multiple of 1/kSplineQuantum.
 bool set_key(SplinePrototype& p, SplinePath path, int index, float phase, int channel, float value);
 
 // Empty when the loader would take `p` for `path`; else what is wrong.

@@ -130,6 +130,10 @@ std::string set_toml_value(std::string_view text, std::string_view table, std::s
             if (current == table) last_in_table = static_cast<int>(i);
             continue;
         }
+        if (trim(line).substr(0, 2) == "[[") {  // an array of tables ([[terrain.box]]): its keys are not the table's
+            current = "[[";
+            continue;
+        }
         if (current != table) continue;
         const std::string_view k = key_of(line.substr(0, comment_start(line)));
         if (k.empty()) continue;

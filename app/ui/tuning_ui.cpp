@@ -237,8 +237,9 @@ void TuningUi::feed_navigation() {
         std::max(held(Button::left_shoulder), static_cast<float>(pad_.left_trigger) / kTriggerScale);
     io.NavInputs[ImGuiNavInput_TweakFast] =
         std::max(held(Button::right_shoulder), static_cast<float>(pad_.right_trigger) / kTriggerScale);
-    const float lx = static_cast<float>(pad_.left_x) / kStickScale;
-    const float ly = static_cast<float>(pad_.left_y) / kStickScale;
+    // In the spline editor's d-pad mode the left stick walks the puppet, it does not scroll.
+    const float lx = spline_pad_ ? 0.0f : static_cast<float>(pad_.left_x) / kStickScale;
+    const float ly = spline_pad_ ? 0.0f : static_cast<float>(pad_.left_y) / kStickScale;
     io.NavInputs[ImGuiNavInput_LStickLeft] = std::max(0.0f, -lx);
     io.NavInputs[ImGuiNavInput_LStickRight] = std::max(0.0f, lx);
     io.NavInputs[ImGuiNavInput_LStickUp] = std::max(0.0f, ly);
