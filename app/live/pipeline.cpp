@@ -531,7 +531,8 @@ std::vector<std::pair<std::string, std::string>> config_lines(const SimConfig& c
         if (end == std::string::npos) end = text.size();
         const std::string line = text.substr(at, end - at);
         at = end + 1;
-        if (line.size() > 2 && line.front() == '[') table = line.substr(1, line.size() - 2);
+        // A header may carry a comment ("[gait.walk]   # keys ..."): the name ends at its first ']'.
+        if (line.size() > 2 && line.front() == '[') table = line.substr(1, line.find(']', 2) - 1);
         else if (const size_t eq = line.find(" = "); eq != std::string::npos)
             out.emplace_back(table + "." + line.substr(0, eq), line.substr(eq + 3));
     }
