@@ -166,6 +166,7 @@ void TuningUi::draw_spline_canvas(float width) {
     if (!ImGui::IsItemActive()) spline_drag_ = -1;
 
     ImDrawList* dl = ImGui::GetWindowDrawList();
+    dl->PushClipRect(o, ImVec2(o.x + size.x, o.y + size.y), true);  // the faint channels may leave the scale
     dl->AddRectFilled(o, ImVec2(o.x + size.x, o.y + size.y), IM_COL32(20, 24, 30, 230));
     dl->AddRect(o, ImVec2(o.x + size.x, o.y + size.y),
                 spline_pad_ ? IM_COL32(255, 200, 60, 255) : IM_COL32(90, 100, 120, 255));
@@ -191,6 +192,7 @@ void TuningUi::draw_spline_canvas(float width) {
                             : fixed         ? IM_COL32(140, 140, 140, 255)
                                             : IM_COL32(240, 240, 240, 255));
     }
+    dl->PopClipRect();
 }
 
 void TuningUi::draw_spline_section(float width) {
@@ -218,11 +220,10 @@ void TuningUi::draw_spline_section(float width) {
     draw_spline_canvas(width);
     const SplinePrototype& p = prototype_of(working_.sim, spline.gait, spline.path);
     const PrototypeKey& k = p.keys[static_cast<std::size_t>(spline.key)];
-    ImGui::Text("%s.%s key %d of %d: phase %.3f  x %.4f  y %.4f  z %.4f", gait_table(spline.gait), path_key(spline.path),
-                spline.key, p.count, static_cast<double>(k.phase), static_cast<double>(k.x), static_cast<double>(k.y),
-                static_cast<double>(k.z));
-    ImGui::TextDisabled(spline_pad_ ? "d-pad: move the key  A: next key  B: done  LB/RB: fine/coarse"
-                                    : "drag a key with the mouse, or A on the curve to step it with the d-pad");
+    ImGui::Text("key %d/%d  phase %.3f  x %.4f  y %.4f  z %.4f", spline.key, p.count, static_cast<double>(k.phase),
+                static_cast<double>(k.x), static_cast<double>(k.y), static_cast<double>(k.z));
+    ImGui::TextDisabled(spline_pad_ ? "d-pad: move  A: next key  B: done  LB/RB: fine/coarse"
+                                    : "drag a key, or A on the curve: the d-pad steps it");
 }
 
 }  // namespace marionette::ui
