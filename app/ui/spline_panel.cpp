@@ -197,7 +197,10 @@ void TuningUi::draw_spline_canvas(float width) {
 
 void TuningUi::draw_spline_section(float width) {
     if (jump_to_spline_) ImGui::SetNextItemOpen(true);
-    if (!ImGui::CollapsingHeader("[gait.walk] / [gait.run] spline editor")) return;
+    if (!ImGui::CollapsingHeader("[gait.walk] / [gait.run] spline editor")) {
+        if (spline_pad_) set_spline_pad_mode(false);  // collapsed (the mouse): the d-pad navigates again
+        return;
+    }
     int gait = static_cast<int>(spline.gait), path = static_cast<int>(spline.path);
     ImGui::RadioButton("walk", &gait, 0);
     ImGui::SameLine();
