@@ -82,7 +82,15 @@ void SimulationLoop::run_tick(std::int64_t tick_time_ns, std::int64_t now_ns) {
         (void)shared_.pad_events.try_push(ui::PadPress{event, k + 1});  // full: nobody is reading (no display), drop it
     previous_buttons_ = pad.buttons;
     // The tuning UI is open: the pad drives it, the puppet gets (and the log records) rest.
-    const TickInput input = shared_.ui_captures_input.load(std::memory_order_relaxed) ? TickInput{} : pad;
+    // In the spline editor's d-pad mode the sticks still walk it (the puppet keeps walking while a key moves).
+    TickInput input = pad;
+    if (shared_.ui_captures_input.load(std::memory_order_relaxed)) {
+        input = TickInput{};
+        if (shared_.ui_passes_sticks.load(std::memory_order_relaxed)) {
+            input.left_x = pad.left_x, input.left_y = pad.left_y;
+            input.right_x = pad.right_x, input.right_y = pad.right_y;
+        }
+    }
     if ((k + 1) % static_cast<std::uint64_t>(sim_.config().tick_rate_hz) == 0) {
         shared_.counters.input_latency_max_ns.store(latency_window_max_ns_, std::memory_order_relaxed);
         latency_window_max_ns_ = 0;
@@ -391,6 +399,7 @@ void feed_tuning_ui(ui::TuningUi* tuning, PipelineShared& sh, const StateFrame& 
         (void)sh.pad_events.try_pop(event);
     }
     tuning->feed_pad(pair.pad, pair.current.tick, pair.tick_ns, event, sh.pad_events.peek() == nullptr);
+    sh.ui_passes_sticks.store(tuning->is_open() && tuning->spline_pad_mode(), std::memory_order_relaxed);
     sh.ui_captures_input.store(tuning->is_open(), std::memory_order_relaxed);
 }
 
@@ -522,7 +531,8 @@ std::vector<std::pair<std::string, std::string>> config_lines(const SimConfig& c
         if (end == std::string::npos) end = text.size();
         const std::string line = text.substr(at, end - at);
         at = end + 1;
-        if (line.size() > 2 && line.front() == '[') table = line.substr(1, line.size() - 2);
+        // A header may carry a comment ("[gait.walk]   # keys ..."): the name ends at its first ']'.
+        if (line.size() > 2 && line.front() == '[') table = line.substr(1, line.find(']', 2) - 1);
         else if (const size_t eq = line.find(" = "); eq != std::string::npos)
             out.emplace_back(table + "." + line.substr(0, eq), line.substr(eq + 3));
     }

@@ -134,6 +134,9 @@ struct PipelineShared {
     // edits go to the writer, and every configuration the writer hands over
     // comes back to it, so a file edit and a panel edit never undo each other.
     std::atomic<bool> ui_captures_input{false};
+    // …except the sticks while the spline editor's d-pad mode is on: the puppet
+    // keeps walking (the left stick) while the d-pad steps a key; recorded as given.
+    std::atomic<bool> ui_passes_sticks{false};
     ui::PadEventRing pad_events;       // presses with their ticks, in order (ui::press_event)
     LatestValue<UiEdit> ui_edits;
     LatestValue<SimConfig> accepted_configs;

@@ -5,10 +5,14 @@
 #include <imgui_internal.h>  // SetFocusID: west puts the pad on the section's first button
 
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
+#include "app/config/config.hpp"
 #include "app/config/terrain_file.hpp"
+#include "app/io/files.hpp"
 #include "app/ui/terrain_edit.hpp"
+#include "app/ui/toml_edit.hpp"
 #include "app/ui/tuning_ui.hpp"
 
 namespace marionette::ui {
@@ -130,9 +134,45 @@ bool TuningUi::save_terrain(const std::string& path) {
         say("save terrain: " + path + ": " + problem, true);
         return false;
     }
-    say("saved the terrain (" + describe(working_.sim.terrain) + ") to " + path +
-            (path == working_.sim.terrain_name ? "" : "; point [terrain] name at it to start on it"),
+    if (!name_terrain_in_config(path)) return false;
+    say("saved the terrain (" + describe(working_.sim.terrain) + ") to " + path + "; [terrain] name = \"" + path +
+            "\" in " + std::string(path_buffer_.data()),
         false);
+    return true;
+}
+
+// `[terrain] name = "PATH"` into the configuration file Save writes (the panel's
+// file field), comments kept, so `run --config` starts on the saved terrain;
+// checked by loading the result, which must give the working terrain.
+bool TuningUi::name_terrain_in_config(const std::string& terrain_path) {
+    const std::string config = path_buffer_.data();
+    if (config.empty()) {
+        say("save terrain: written to " + terrain_path + ", but no configuration file is named to point at it", true);
+        return false;
+    }
+    std::string text = "# marionette configuration, saved by the tuning UI (docs/ui.md)\n";
+    std::string quoted = "\"";
+    for (char c : terrain_path) quoted += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
+    quoted += "\"";
+    try {
+        if (std::filesystem::exists(config)) text = read_text_file(config);
+        text = set_toml_value(text, "terrain", "name", quoted);
+        const AppConfig loaded = apply_config_text(default_config(), text, config);
+        if (!(loaded.sim.terrain == working_.sim.terrain)) {
+            say("save terrain: written to " + terrain_path + "; " + config +
+                    " not changed: with [terrain] name pointing at it, it would start on other ground "
+                    "(inline [terrain] data in it win over name)",
+                true);
+            return false;
+        }
+    } catch (const std::exception& e) {
+        say("save terrain: written to " + terrain_path + "; " + config + " not changed: " + e.what(), true);
+        return false;
+    }
+    if (const std::string problem = write_replacing(config, text); !problem.empty()) {
+        say("save terrain: written to " + terrain_path + "; " + problem, true);
+        return false;
+    }
     return true;
 }
 

@@ -1,6 +1,9 @@
 #include "app/ui/toml_edit.hpp"
 
+#include <algorithm>
 #include <cstddef>
+#include <filesystem>
+#include <fstream>
 #include <vector>
 
 namespace marionette::ui {
@@ -84,6 +87,35 @@ std::string replace_value(std::string_view line, std::string_view value) {
     return out;
 }
 
+// '[' minus ']' in the line's code (outside strings and the comment).
+int bracket_depth(std::string_view line) {
+    int depth = 0;
+    const std::size_t end = std::min(comment_start(line), line.size());
+    char quote = 0;
+    for (std::size_t i = 0; i < end; ++i) {
+        const char c = line[i];
+        if (quote) {
+            if (c == '\\' && quote == '"') ++i;
+            else if (c == quote) quote = 0;
+        } else if (c == '"' || c == '\'') {
+            quote = c;
+        } else {
+            depth += c == '[' ? 1 : c == ']' ? -1 : 0;
+        }
+    }
+    return depth;
+}
+
+// The last line of the value that starts on line `first` (an array written
+// over several lines ends where its brackets close).
+std::size_t value_end(const std::vector<Line>& lines, std::size_t first) {
+    const std::string_view line = lines[first].text;
+    int depth = bracket_depth(line.substr(line.find('=') + 1));
+    std::size_t i = first;
+    while (depth > 0 && i + 1 < lines.size()) depth += bracket_depth(lines[++i].text);
+    return i;
+}
+
 }  // namespace
 
 std::string set_toml_value(std::string_view text, std::string_view table, std::string_view key, std::string_view value) {
@@ -98,6 +130,10 @@ std::string set_toml_value(std::string_view text, std::string_view table, std::s
             if (current == table) last_in_table = static_cast<int>(i);
             continue;
         }
+        if (trim(line).substr(0, 2) == "[[") {  // an array of tables ([[terrain.box]]): its keys are not the table's
+            current = "[[";
+            continue;
+        }
         if (current != table) continue;
         const std::string_view k = key_of(line.substr(0, comment_start(line)));
         if (k.empty()) continue;
@@ -108,7 +144,19 @@ std::string set_toml_value(std::string_view text, std::string_view table, std::s
     std::string out;
     out.reserve(text.size() + assignment.size() + table.size() + 8);
     const int insert_after = found < 0 ? last_in_table : -1;
+    // A multi-line array: its first line keeps the key and spacing, its last
+    // line's trailing comment stays; the lines between go.
+    const std::size_t found_end = found < 0 ? 0 : value_end(lines, static_cast<std::size_t>(found));
     for (std::size_t i = 0; i < lines.size(); ++i) {
+        if (found >= 0 && i > static_cast<std::size_t>(found) && i <= found_end) continue;
+        if (static_cast<int>(i) == found && found_end > i) {
+            const std::string_view first = lines[i].text, last = lines[found_end].text;
+            const std::size_t comment = comment_start(last);
+            out += replace_value(first.substr(0, std::min(comment_start(first), first.size())), value);
+            if (comment != std::string_view::npos) out += " " + std::string(last.substr(comment));
+            if (lines[found_end].has_newline) out += '\n';
+            continue;
+        }
         if (static_cast<int>(i) == found) out += replace_value(lines[i].text, value);
         else out += lines[i].text;
         if (static_cast<int>(i) == insert_after) {
@@ -123,6 +171,21 @@ std::string set_toml_value(std::string_view text, std::string_view table, std::s
         out += "[" + std::string(table) + "]\n" + assignment + "\n";
     }
     return out;
+}
+
+// Written beside it and renamed over it: a reader (the watcher) never sees half
+// a file. Empty: written; else what failed, naming the file.
+std::string write_replacing(const std::string& path, const std::string& text) {
+    const std::string temporary = path + ".tmp";
+    {
+        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+        out << text;
+        if (!out.flush()) return "cannot write " + temporary;
+    }
+    std::error_code ec;
+    std::filesystem::rename(temporary, path, ec);
+    if (ec) return "cannot replace " + path + ": " + ec.message();
+    return {};
 }
 
 }  // namespace marionette::ui

@@ -16,4 +16,9 @@ namespace marionette::ui {
 // `text` with `table.key` set to `value` (TOML text of the value, e.g. "0.62").
 std::string set_toml_value(std::string_view text, std::string_view table, std::string_view key, std::string_view value);
 
+// Writes `text` to `path` beside it (path + ".tmp") and renames it over it: a
+// reader (the config watcher) never sees half a file. Empty: written; else what
+// failed, naming the file.
+std::string write_replacing(const std::string& path, const std::string& text);
+
 }  // namespace marionette::ui

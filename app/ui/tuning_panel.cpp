@@ -130,7 +130,7 @@ void TuningUi::draw_panel(float width, float height) {
     if (!first_drawn) focus_first_ = false;  // its section is collapsed: ImGui's own choice stands
     ImGui::PopItemWidth();
     draw_terrain_section();
-    ImGui::TextDisabled("[gait.walk], [gait.run] prototypes: edit the TOML (no spline editor yet)");
+    draw_spline_section(ImGui::GetContentRegionAvail().x);
     ImGui::End();
 }
 

@@ -88,6 +88,7 @@ void TuningUi::set_open(bool open) {
     if (open == open_) return;
     open_ = open;
     stepper_ = PadStepper{};  // a d-pad held across the chord does not repeat into the panel
+    spline_pad_ = false;
     steps_ = 0;
     focus_first_ = open;
     focus_frames_ = 0;
@@ -143,6 +144,13 @@ bool TuningUi::reset(const PanelKey& key) {
     return value && edit(key.table, key.key, *value);
 }
 
+std::optional<std::string> TuningUi::edited_value_text(const std::string& table, const std::string& key) const {
+    for (SplineGait g : {SplineGait::walk, SplineGait::run})
+        for (SplinePath p : {SplinePath::swing_foot, SplinePath::pelvis, SplinePath::hand})
+            if (table == gait_table(g) && key == path_key(p)) return prototype_toml(prototype_of(working_.sim, g, p));
+    return config_value_text(working_, table, key);
+}
+
 bool TuningUi::save(const std::string& path) {
     if (path.empty()) {
         say("save: no file name", true);
@@ -160,7 +168,7 @@ bool TuningUi::save(const std::string& path) {
         const std::size_t dot = full.rfind('.');
         const std::string table = full.substr(0, dot);
         const std::string key = full.substr(dot + 1);
-        const std::optional<std::string> value = config_value_text(working_, table, key);
+        const std::optional<std::string> value = edited_value_text(table, key);
         if (value) text = set_toml_value(text, table, key, *value);
     }
     try {
@@ -169,20 +177,8 @@ bool TuningUi::save(const std::string& path) {
         say("save: not written, the result would not load: " + std::string(e.what()), true);
         return false;
     }
-    // Written beside it and renamed over it: a reader (the watcher) never sees half a file.
-    const std::string temporary = path + ".tmp";
-    {
-        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-        out << text;
-        if (!out.flush()) {
-            say("save: cannot write " + temporary, true);
-            return false;
-        }
-    }
-    std::error_code ec;
-    std::filesystem::rename(temporary, path, ec);
-    if (ec) {
-        say("save: cannot replace " + path + ": " + ec.message(), true);
+    if (const std::string problem = write_replacing(path, text); !problem.empty()) {
+        say("save: " + problem, true);
         return false;
     }
     save_path_ = path;
@@ -228,6 +224,7 @@ bool TuningUi::on_native_event(const void* native) {
 // modifiers and the stick are held values.
 void TuningUi::feed_navigation() {
     ImGuiIO& io = ImGui::GetIO();
+    if (spline_pad_) spline_pad_steps();  // takes the d-pad, south and east from ImGui
     auto down = [&](Button b) { return (steps_ & button_bit(b)) != 0 ? 1.0f : 0.0f; };
     auto held = [&](Button b) { return (pad_.buttons & button_bit(b)) != 0 ? 1.0f : 0.0f; };
     io.NavInputs[ImGuiNavInput_Activate] = down(Button::south);
@@ -240,17 +237,20 @@ void TuningUi::feed_navigation() {
         std::max(held(Button::left_shoulder), static_cast<float>(pad_.left_trigger) / kTriggerScale);
     io.NavInputs[ImGuiNavInput_TweakFast] =
         std::max(held(Button::right_shoulder), static_cast<float>(pad_.right_trigger) / kTriggerScale);
-    const float lx = static_cast<float>(pad_.left_x) / kStickScale;
-    const float ly = static_cast<float>(pad_.left_y) / kStickScale;
+    // In the spline editor's d-pad mode the left stick walks the puppet, it does not scroll.
+    const float lx = spline_pad_ ? 0.0f : static_cast<float>(pad_.left_x) / kStickScale;
+    const float ly = spline_pad_ ? 0.0f : static_cast<float>(pad_.left_y) / kStickScale;
     io.NavInputs[ImGuiNavInput_LStickLeft] = std::max(0.0f, -lx);
     io.NavInputs[ImGuiNavInput_LStickRight] = std::max(0.0f, lx);
     io.NavInputs[ImGuiNavInput_LStickUp] = std::max(0.0f, ly);
     io.NavInputs[ImGuiNavInput_LStickDown] = std::max(0.0f, -ly);
     // North saves (our shortcut; ImGui's own use of it, text input, is not needed here).
     if (press_ & button_bit(Button::north)) save(std::string(path_buffer_.data()));
-    // West jumps to the terrain editor (opened, its first button focused): far below the sliders otherwise.
+    // West jumps to the terrain editor (opened, its first button focused): far
+    // below the sliders otherwise; pressed again, to the spline editor's curve.
     if (press_ & button_bit(Button::west)) {
-        jump_to_terrain_ = true;
+        (next_jump_spline_ ? jump_to_spline_ : jump_to_terrain_) = true;
+        next_jump_spline_ = !next_jump_spline_;
         jump_frames_ = 0;
     }
 }

@@ -18,12 +18,14 @@
 #include <initializer_list>
 #include <utility>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "app/config/app_config.hpp"
 #include "app/ui/pad_presses.hpp"
+#include "app/ui/spline_edit.hpp"
 #include "render_es/platform.hpp"
 #include "render_es/view.hpp"
 #include "runtime/sim/tick_input.hpp"
@@ -95,7 +97,7 @@ public:
     // shows it released, or the panel, just opened, is still putting the focus on
     // its first slider (a step taken then would be undone by it), or west just
     // moved it to the terrain editor.
-    bool releasing() const { return stepper_.releasing() || focus_first_ || jump_to_terrain_; }
+    bool releasing() const { return stepper_.releasing() || focus_first_ || jump_to_terrain_ || jump_to_spline_; }
     bool is_open() const { return open_; }
     void set_open(bool open);
     // A configuration the writer thread has accepted (a file edit, or ours).
@@ -134,6 +136,26 @@ public:
     bool save_terrain(const std::string& path);
     std::string terrain_save_path() const;
 
+    // The spline editor (docs/ui.md, "Spline editor"): the selected prototype,
+    // key and channel (0 x, 1 y, 2 z); key 0 of the swing cannot move, so 1.
+    struct SplineSelection {
+        SplineGait gait = SplineGait::walk;
+        SplinePath path = SplinePath::swing_foot;
+        int key = 1;
+        int channel = 1;
+    };
+    SplineSelection spline;
+    // Moves the selected key by a phase and a value step (clamped, spline_edit.hpp)
+    // or to an absolute phase and value (a mouse drag); handed over like a
+    // slider's edit. False (message() says why) when nothing changes.
+    bool spline_move(float dphase, float dvalue);
+    bool spline_set(float phase, float value);
+    void spline_select_next();  // the next key of the selected prototype (wraps)
+    // South on the curve: the d-pad moves the selected key (left/right phase,
+    // up/down value, LB/RB 10x finer/coarser), south selects the next key, east leaves.
+    bool spline_pad_mode() const { return spline_pad_; }
+    void set_spline_pad_mode(bool on);
+
     void draw(std::int32_t width, std::int32_t height, float dt_s) override;
     void recreate() override;
     bool on_native_event(const void* event) override;
@@ -145,6 +167,12 @@ private:
     void draw_terrain_section();
     void terrain_buttons(const char* label, std::initializer_list<std::pair<const char*, TerrainAction>> buttons);
     void say(const std::string& line, bool problem);
+    bool edit_prototype(const SplinePrototype& next);
+    std::optional<std::string> edited_value_text(const std::string& table, const std::string& key) const;
+    bool name_terrain_in_config(const std::string& terrain_path);
+    void spline_pad_steps();
+    void draw_spline_section(float width);
+    void draw_spline_canvas(float width);
 
     render::Platform& platform_;
     TuningUiOptions options_;
@@ -172,6 +200,11 @@ private:
     int selected_box_ = -1, selected_slope_ = -1;  // -1: none
     bool jump_to_terrain_ = false;  // west was pressed: open the terrain section, focus its first button
     int jump_frames_ = 0;
+    bool jump_to_spline_ = false;    // west again: the spline editor's curve gets the focus
+    bool next_jump_spline_ = false;  // west alternates: terrain editor, spline editor
+    bool spline_pad_ = false;
+    int spline_drag_ = -1;           // the key the mouse drags, -1: none
+    float drag_lo_ = 0.0f, drag_hi_ = 1.0f;  // the curve's value range, held while dragging
 };
 
 }  // namespace marionette::ui

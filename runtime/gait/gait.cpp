@@ -42,6 +42,8 @@ HeadingFrame heading_frame(double heading) {
 }
 float side_sign(int foot) { return foot == 0 ? 1.0f : -1.0f; }  // left foot is on +X
 
+}  // namespace
+
 // Prototype → Hermite keys. Tangents from the neighbours (Catmull–Rom on uneven
 // phases); a looping path wraps them, an open one (swing) starts and ends at rest.
 int build_prototype_keys(const SplinePrototype& p, bool loops, std::array<HermiteKey, kMaxPrototypeKeys>& out) {
@@ -66,6 +68,8 @@ int build_prototype_keys(const SplinePrototype& p, bool loops, std::array<Hermit
     }
     return n;
 }
+
+namespace {
 
 vec3 eval_keys(const std::array<HermiteKey, kMaxPrototypeKeys>& keys, int count, float phase) {
     return sample_hermite(std::span<const HermiteKey>(keys.data(), static_cast<std::size_t>(count)), phase).position;

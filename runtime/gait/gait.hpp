@@ -69,6 +69,12 @@ struct GaitState {
     std::int32_t flight_phases_open = 0;      // both feet are off the ground now
 };
 
+// A prototype as the gait evaluates it: Hermite keys at its phases, tangents from
+// the neighbouring keys (Catmull–Rom on uneven phases); a looping path wraps them,
+// an open one (the swing) starts and ends at rest. Returns the key count. The
+// tuning UI's spline editor draws the same curves (app/ui/spline_panel.cpp).
+int build_prototype_keys(const SplinePrototype& p, bool loops, std::array<HermiteKey, kMaxPrototypeKeys>& out);
+
 // Everything the gait needs from the configuration and skeleton, prepared once:
 // prototype splines as Hermite keys, bone lengths, offsets.
 struct GaitRig {

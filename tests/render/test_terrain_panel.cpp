@@ -10,6 +10,7 @@
 
 #include "app/config/config.hpp"
 #include "app/config/terrain_file.hpp"
+#include "app/io/files.hpp"
 #include "app/ui/pad_presses.hpp"
 #include "app/ui/tuning_ui.hpp"
 #include "render_es/view.hpp"
@@ -34,7 +35,8 @@ TEST_CASE("terrain editor steps: add under the puppet, move, raise, resize, tilt
     base.sim.terrain = load_terrain("flat");
     base.sim.terrain_name = "flat";
     render::View view(panel_platform(), render::RenderSettings{}, make_puppet_skeleton(base.sim), base.sim.terrain);
-    ui::TuningUi tuning(view.platform(), ui::TuningUiOptions{base, "", "", stderr});
+    // Save terrain also names the file in the configuration Save writes: this test's own.
+    ui::TuningUi tuning(view.platform(), ui::TuningUiOptions{base, "", "terrain_steps_tuned.toml", stderr});
     AppConfig handed;
     CHECK_FALSE(tuning.take_edit(handed));
 
@@ -84,7 +86,9 @@ TEST_CASE("terrain editor steps: add under the puppet, move, raise, resize, tilt
     CHECK(path == "marionette-terrain.toml");
     REQUIRE(tuning.save_terrain(path));
     CHECK(load_terrain(path) == t);
+    CHECK(load_config("terrain_steps_tuned.toml").sim.terrain == t);
     std::filesystem::remove(path);
+    std::filesystem::remove("terrain_steps_tuned.toml");
 
     CHECK(tuning.terrain_action(A::box_delete));
     CHECK(tuning.terrain_action(A::slope_delete));
@@ -97,7 +101,7 @@ TEST_CASE("terrain editor steps: add under the puppet, move, raise, resize, tilt
 TEST_CASE("generated terrain editor step sequences stay loadable and the simulation takes each", "[render][ui][terrain]") {
     AppConfig base = default_config();  // the stairs
     render::View view(panel_platform(), render::RenderSettings{}, make_puppet_skeleton(base.sim), base.sim.terrain);
-    ui::TuningUi tuning(view.platform(), ui::TuningUiOptions{base, "", "", stderr});
+    ui::TuningUi tuning(view.platform(), ui::TuningUiOptions{base, "", "terrain_west_tuned.toml", stderr});
     Simulation sim(base.sim);
     std::mt19937 rng(19);  // fixed seed
     const int last = static_cast<int>(A::brush_lower);
@@ -122,7 +126,7 @@ TEST_CASE("generated terrain editor step sequences stay loadable and the simulat
 TEST_CASE("west takes the pad to the terrain editor, south adds a box, down to Save terrain saves", "[render][ui][terrain]") {
     AppConfig base = default_config();  // the stairs
     render::View view(panel_platform(), render::RenderSettings{}, make_puppet_skeleton(base.sim), base.sim.terrain);
-    ui::TuningUi tuning(view.platform(), ui::TuningUiOptions{base, "", "", stderr});
+    ui::TuningUi tuning(view.platform(), ui::TuningUiOptions{base, "", "terrain_west_tuned.toml", stderr});
     view.set_layer(&tuning);
     std::uint32_t held = 0;
     std::uint64_t tick = 0;
@@ -158,7 +162,9 @@ TEST_CASE("west takes the pad to the terrain editor, south adds a box, down to S
     press(Button::south);
     CHECK_THAT(tuning.message(), Catch::Contains("saved the terrain"));
     CHECK(load_terrain("marionette-terrain.toml") == tuning.working().sim.terrain);
+    CHECK_THAT(read_text_file("terrain_west_tuned.toml"), Catch::Contains("name = \"marionette-terrain.toml\""));
     std::filesystem::remove("marionette-terrain.toml");
+    std::filesystem::remove("terrain_west_tuned.toml");
     // No slider was touched on the way.
     CHECK(serialize_config(handed.sim) == [&] {
         SimConfig expected = base.sim;

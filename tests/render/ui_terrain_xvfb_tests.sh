@@ -6,25 +6,9 @@
 # `replay` of the recording gives the run's final hash, and the saved terrain
 # file holds the stairs' boxes plus the new one.
 # Usage: ui_terrain_xvfb_tests.sh MARIONETTE_BINARY SOURCE_DIR
-set -u
 bin=$1
 src=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-cd "$work"
-passes=0
-failures=0
-check() {
-  local what=$1
-  shift
-  if "$@"; then passes=$((passes + 1)); else failures=$((failures + 1)); echo "FAIL: $what"; fi
-}
-if ! command -v xvfb-run >/dev/null; then
-  echo "xvfb-run is not installed (scripts/setup.sh installs it)"
-  exit 1
-fi
-mkdir -p home/.config/marionette
-printf '[display]\nwidth = 640\nheight = 400\nmsaa_samples = 0\n' >home/.config/marionette/render.toml
+source "$(dirname "${BASH_SOURCE[0]}")/xvfb_common.sh"
 
 # West jumps to the terrain editor (opened, the pad on "add box"); each tap is
 # one step however slow the frames (app/ui/pad_presses.hpp); eight downs reach
@@ -63,9 +47,8 @@ ramp 300ms ly=0
 hold 1s
 PROG
 
-HOME=$work/home XDG_CONFIG_HOME=$work/home/.config LIBGL_ALWAYS_SOFTWARE=1 xvfb-run -a -s "-screen 0 800x600x24" "$bin" run --display window --input sim:terrain.prog --duration 16 \
-  --record terrain.mlog --stats-json stats.json >run.txt 2>run.err
-code=$?
+run_in_window --input sim:terrain.prog --duration 16 --record terrain.mlog --stats-json stats.json
+code=$run_code
 check "run under Xvfb exits 0 (got $code)" test $code -eq 0
 check "the chord opened the UI" grep -q "^ui: opened" run.txt
 check "the pad added a box under the puppet" grep -q "^ui: terrain: added box [0-9]* under the puppet" run.txt
@@ -78,9 +61,18 @@ check "the saved terrain has the stairs' boxes plus one ($boxes, stairs $stairs)
 hash=$(sed -E 's/.*"final_hash":"([0-9a-f]+)".*/\1/' stats.json)
 check "replay of the recording gives the run's final hash ($hash)" test "$hash" = "$("$bin" replay terrain.mlog --hash)"
 check "the run says it applied a configuration change" grep -q '"config_changes":[1-9]' stats.json
+# Save terrain named the file in the configuration Save writes (no --config
+# here: marionette-tuned.toml), so a restart with it starts on the edited ground:
+# standing at the start, the puppet is higher by about the new box's 0.1 m.
+check "Save terrain wrote [terrain] name into marionette-tuned.toml" grep -q '^name = "marionette-terrain.toml"' marionette-tuned.toml
+printf 'hold 1s\n' >stand.prog
+stand_height() {  # root height at the last tick of a 1 s headless stand, with ARGS
+  HOME=$work/home XDG_CONFIG_HOME=$work/home/.config "$bin" run --display headless --input sim:stand.prog --duration 1 \
+    --record stand.mlog "$@" >/dev/null 2>&1 && "$bin" replay stand.mlog --trace stand.csv >/dev/null && tail -1 stand.csv | cut -d, -f4
+}
+before=$(stand_height)
+after=$(stand_height --config marionette-tuned.toml)
+check "run --config marionette-tuned.toml starts on the saved terrain (root y $before -> $after)" \
+  awk -v a="$before" -v b="$after" 'BEGIN { exit !(a != "" && b != "" && b - a > 0.05 && b - a < 0.15) }'
 grep -E "^(ui|config): |config: applied" run.txt
-if ((failures > 0)); then
-  echo "--- run.txt"; cat run.txt; echo "--- run.err"; cat run.err
-fi
-echo "$passes passed, $failures failed"
-[[ $failures -eq 0 ]]
+finish marionette-tuned.toml

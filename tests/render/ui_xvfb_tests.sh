@@ -5,22 +5,8 @@
 # UI; the saved TOML has the new value and the old comments, the log records
 # the edit as a configuration change, and `replay` gives the run's final hash.
 # Usage: ui_xvfb_tests.sh MARIONETTE_BINARY
-set -u
 bin=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-cd "$work"
-passes=0
-failures=0
-check() {
-  local what=$1
-  shift
-  if "$@"; then passes=$((passes + 1)); else failures=$((failures + 1)); echo "FAIL: $what"; fi
-}
-if ! command -v xvfb-run >/dev/null; then
-  echo "xvfb-run is not installed (scripts/setup.sh installs it)"
-  exit 1
-fi
+source "$(dirname "${BASH_SOURCE[0]}")/xvfb_common.sh"
 
 cat >tuned.toml <<'TOML'
 # my walk, tuned on the screen
@@ -29,11 +15,6 @@ walk_duty = 0.58            # planted a little longer
 step_length_multiplier = 0.45   # stride
 TOML
 cp tuned.toml original.toml
-# A small window without MSAA: llvmpipe draws it in a few ms on an idle machine.
-# (run reads render.toml from the user's configuration folder.)
-mkdir -p home/.config/marionette
-printf '[display]\nwidth = 640\nheight = 400\nmsaa_samples = 0\n' >home/.config/marionette/render.toml
-
 # Presses are 0.8 s apart (any spacing works: presses are queued and each is one
 # step however long the frames are; 150 ms taps stay under the 0.5 s repeat delay).
 cat >ui.prog <<'PROG'
@@ -60,9 +41,8 @@ ramp 300ms ly=0
 hold 1s
 PROG
 
-HOME=$work/home XDG_CONFIG_HOME=$work/home/.config LIBGL_ALWAYS_SOFTWARE=1 xvfb-run -a -s "-screen 0 800x600x24" "$bin" run --display window --input sim:ui.prog --duration 14 \
-  --config tuned.toml --record ui.mlog --stats-json stats.json >run.txt 2>run.err
-code=$?
+run_in_window --input sim:ui.prog --duration 14 --config tuned.toml --record ui.mlog --stats-json stats.json
+code=$run_code
 check "run under Xvfb exits 0 (got $code)" test $code -eq 0
 check "the chord opened the UI" grep -q "^ui: opened" run.txt
 # Each tap is exactly one step (app/ui/pad_presses.hpp): two edits, 0.45 -> 0.47 -> 0.49, no other row.
@@ -79,8 +59,4 @@ check "replay of the recording gives the run's final hash ($hash)" test "$hash" 
 check "the run says it applied a configuration change" grep -q '"config_changes":[1-9]' stats.json
 grep -E "^(ui|config): " run.txt
 echo "saved: $(grep '^step_length_multiplier' tuned.toml); final hash $hash"
-if ((failures > 0)); then
-  echo "--- run.txt"; cat run.txt; echo "--- run.err"; cat run.err; echo "--- tuned.toml"; cat tuned.toml
-fi
-echo "$passes passed, $failures failed"
-[[ $failures -eq 0 ]]
+finish tuned.toml

@@ -128,3 +128,12 @@ TEST_CASE("generated files: every edit parses back to the new value and leaves e
         }
     }
 }
+
+TEST_CASE("a key is added to its table, not to an array of tables that follows it", "[toml]") {
+    const std::string text = "[terrain]   # ground\n[[terrain.box]]\nmin = [0.0, 0.0]\nmax = [1.0, 1.0]\ntop = 0.1\n";
+    const std::string out = set_toml_value(text, "terrain", "name", "\"mine.toml\"");
+    CHECK(out == "[terrain]   # ground\nname = \"mine.toml\"\n[[terrain.box]]\nmin = [0.0, 0.0]\nmax = [1.0, 1.0]\ntop = 0.1\n");
+    const toml::table parsed = toml::parse(out);
+    CHECK(parsed["terrain"]["name"].value<std::string>() == "mine.toml");
+    CHECK(parsed["terrain"]["box"][0]["top"].value<double>() == 0.1);
+}
