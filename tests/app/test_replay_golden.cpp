@@ -142,6 +142,16 @@ TEST_CASE("replays driven by the default motion graph match the committed golden
         {"graph_actions", test::source_path("config/programs/actions.prog"), "graph", "flat", {}},
         {"graph_feet_circle_stairs", "builtin:circle", "graph_feet", "stairs", {}},
         {"graph_switch_stairs", "builtin:demo", "gait", "stairs", {{480, "graph_feet"}, {1440, "gait"}}},
+        // Motion matching (docs/motion-matching.md) on the database the default
+        // graph's locomotion clips make: the whole demo on stairs (search, jumps,
+        // inertialization, foot placement and the look-ahead lift), and live
+        // switches gait → matching → graph_feet → matching → gait on the slope.
+        {"matching_demo_stairs", "builtin:demo", "matching", "stairs", {}},
+        {"matching_switch_slope",
+         "builtin:demo",
+         "gait",
+         "slope",
+         {{480, "matching"}, {1440, "graph_feet"}, {2400, "matching"}, {3360, "gait"}}},
     };
     for (const GraphGolden& c : cases) {
         INFO("golden " << c.name);
