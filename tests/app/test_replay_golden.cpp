@@ -99,6 +99,7 @@ TEST_CASE("a log whose clip data differ from this build is refused", "[golden]")
 // directory (scripts/update-golden.sh copies them over).
 #include <cstdlib>
 #include <fstream>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <xxhash.h>
@@ -179,6 +180,12 @@ TEST_CASE("replays driven by the default motion graph match the committed golden
             }
             sim.step(ticks[k]);
             recorded.push_back(hash_state(sim.state()));
+        }
+        if (std::string_view(c.name).starts_with("matching")) {
+            // The trace covers searches and inertialized jumps, not one clip played through.
+            INFO("matching searches " << sim.state().matching.searches << ", jumps " << sim.state().matching.jumps);
+            CHECK(sim.state().matching.jumps >= 10);
+            CHECK(sim.state().matching.searches > sim.state().matching.jumps);
         }
         const std::string trace_path = fmt::format("golden_{}.csv", c.name);
         ReplayOptions options;
