@@ -135,7 +135,7 @@ const KeySpec kKeys[] = {
     {"motion_matching", "trajectory_facing_weight", &SimConfig::matching_trajectory_facing_weight, 0.0, 100.0, "weight of the future facings (1/3, 2/3, 1 s)"},
     {"motion_matching", "search_interval_s", &SimConfig::matching_search_interval_s, 0.005, 2.0, "the database is searched at least this often (s)"},
     {"motion_matching", "search_threshold_m", &SimConfig::matching_search_threshold_m, 0.01, 10.0, "… and whenever the desired trajectory is this far from the playing frame's (m)"},
-    {"motion_matching", "inertialization_s", &SimConfig::matching_inertialization_s, 0.01, 2.0, "a jump's pose offsets and their velocities decay as springs of halflife inertialization_s / 3 (s)"},
+    {"motion_matching", "inertialization_s", &SimConfig::matching_inertialization_s, 0.01, 2.0, "a jump's pose offsets decay to zero over this long (s)"},
     {"motion_matching", "velocity_halflife_s", &SimConfig::matching_velocity_halflife_s, 0.01, 2.0, "halflife of the spring carrying the desired velocity toward the stick's (s)"},
     {"motion_matching", "facing_halflife_s", &SimConfig::matching_facing_halflife_s, 0.01, 2.0, "halflife of the spring carrying the desired facing toward the stick's (s)"},
     {"motion_matching", "correction_halflife_s", &SimConfig::matching_correction_halflife_s, 0.01, 2.0, "halflife of the pull of the character's root toward the desired trajectory (s)"},
