@@ -2,7 +2,7 @@
 # Bit-identical replay on aarch64 (docs/determinism.md): installs Debian's cross
 # toolchain, the :arm64 -dev packages and qemu user-mode emulation, cross-builds
 # the golden tests (the deterministic core only) and runs them under qemu: every
-# golden trace (gait and motion graph) must match bit for bit. Ends with a line
+# golden trace (gait, motion graph and motion matching) must match bit for bit. Ends with a line
 # saying how many goldens were identical.
 set -euo pipefail
 cd "$(dirname "$0")/.."

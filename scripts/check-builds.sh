@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Determinism across build types and compilers: builds the golden-trace tests
-# (tests/app/test_replay_golden.cpp: every shipped program with the gait, and the
-# motion-graph goldens with graph, graph_feet and a live source switch) in the
+# (tests/app/test_replay_golden.cpp: every shipped program with the gait, the
+# motion-graph goldens with graph, graph_feet and a live source switch, and the
+# motion-matching goldens: a whole run and switches to and from matching) in the
 # configurations the presets do not cover, and runs them. Each configuration
 # compiles only the deterministic core (MARIONETTE_CORE_ONLY). The release and
 # asan presets already run the goldens in scripts/test.sh.

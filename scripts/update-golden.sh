@@ -17,7 +17,7 @@ done
 # written by the test itself, with the default graph's hash they belong to.
 cmake --build --preset release --target marionette_golden_tests
 (cd "$tmp" && MARIONETTE_WRITE_GOLDEN=1 "$OLDPWD/build/release/tests/marionette_golden_tests" "[golden_graph]" >/dev/null)
-for name in graph_actions graph_feet_circle_stairs graph_switch_stairs; do
+for name in graph_actions graph_feet_circle_stairs graph_switch_stairs matching_demo_stairs matching_switch_slope; do
   cp "$tmp/golden_$name.csv" "tests/golden/$name.trace.csv"
 done
 cp "$tmp/default_graph.hash" tests/golden/default_graph.hash

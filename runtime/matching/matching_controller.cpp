@@ -28,8 +28,29 @@ PlanarTransform placement(vec3 c, float clip_heading, vec3 p, float heading) {
     det::sin_cos(angle, sn, cs);
     return {angle, p.x - (cs * c.x + sn * c.z), p.z - (-sn * c.x + cs * c.z)};
 }
-// 1 at u = 0 … 0 at u ≥ 1, with zero slope at both ends.
-float cubic_decay(float u) { return u >= 1.0f ? 0.0f : 1.0f - u * u * (3.0f - 2.0f * u); }
+// Rotation vector (axis × angle, radians, angle ≤ π) of a unit quaternion; owned atan2, no libm.
+vec3 rotation_vector(quat q) {
+    if (q.w < 0.0f) q = quat(-q.w, -q.x, -q.y, -q.z);
+    const double s = std::sqrt(static_cast<double>(q.x) * q.x + static_cast<double>(q.y) * q.y + static_cast<double>(q.z) * q.z);
+    if (s < 1e-9) return vec3(2.0f * q.x, 2.0f * q.y, 2.0f * q.z);
+    const float k = static_cast<float>(2.0 * det::atan2(s, static_cast<double>(q.w)) / s);
+    return vec3(q.x * k, q.y * k, q.z * k);
+}
+// The unit quaternion of a rotation vector; owned sin/cos.
+quat from_rotation_vector(vec3 v) {
+    const double angle = std::sqrt(static_cast<double>(v.x) * v.x + static_cast<double>(v.y) * v.y + static_cast<double>(v.z) * v.z);
+    if (angle < 1e-9) return quat_normalize(quat(1.0f, 0.5f * v.x, 0.5f * v.y, 0.5f * v.z));
+    double sn = 0.0, cs = 0.0;
+    det::sin_cos(0.5 * angle, sn, cs);
+    const float k = static_cast<float>(sn / angle);
+    return quat(static_cast<float>(cs), v.x * k, v.y * k, v.z * k);
+}
+// One critically damped spring toward zero (x offset, v its velocity), y = 2 ln2 / halflife.
+void decay_spring(vec3& x, vec3& v, float y, float e, float dt) {
+    const vec3 j1 = v + x * y;
+    x = (x + j1 * dt) * e;
+    v = (v - j1 * (y * dt)) * e;
+}
 }  // namespace
 
 MatchingController::MatchingController(const MatchingSource& source, const MatchingDatabase& db,
@@ -48,6 +69,8 @@ MatchingController::MatchingController(const MatchingSource& source, const Match
     if (!any) throw std::invalid_argument("matching: no database frame can be searched (clips too short)");
     shown_rotations_.resize(static_cast<size_t>(n));
     shown_translations_.resize(static_cast<size_t>(n));
+    old_angular_.resize(static_cast<size_t>(n));
+    old_linear_.resize(static_cast<size_t>(n));
 }
 
 bool MatchingController::valid(const MatchingState& s, LocalPoseOutput pose) const {
@@ -59,7 +82,6 @@ bool MatchingController::valid(const MatchingState& s, LocalPoseOutput pose) con
 MatchingState MatchingController::initial_state(vec3 position, float heading) const {
     MatchingState s;
     while (!db_.searchable[static_cast<size_t>(s.frame)]) ++s.frame;
-    for (quat& q : s.offset_rotation) q = quat_identity();
     place(s, position, heading);
     return s;
 }
@@ -74,8 +96,8 @@ void MatchingController::place(MatchingState& s, vec3 position, float heading) c
     s.world_angle = w.angle, s.world_dx = w.dx, s.world_dz = w.dz;
     s.spring = TrajectorySpring{};
     s.spring.px = position.x, s.spring.pz = position.z, s.spring.heading = heading;
-    for (quat& q : s.offset_rotation) q = quat_identity();
-    for (vec3& t : s.offset_translation) t = vec3(0.0f);
+    for (auto* a : {&s.offset_rotation, &s.offset_angular_velocity, &s.offset_translation, &s.offset_velocity})
+        for (vec3& v : *a) v = vec3(0.0f);
     s.since_jump = 1e6f;
     s.since_search = 1e6f;  // search at the first tick
 }
@@ -104,7 +126,7 @@ void MatchingController::sample(const MatchingState& s, LocalPoseOutput out, boo
     const size_t f1 = (s.frame + 1 < db_.clip_end[static_cast<size_t>(s.frame)]
                            ? static_cast<size_t>(db_.source_frame[static_cast<size_t>(s.frame) + 1]) : f0 / n) * n;
     const PlanarTransform world{s.world_angle, s.world_dx, s.world_dz};
-    const float decay = offsets ? cubic_decay(s.since_jump / config_.inertialization_s) : 0.0f;
+    const bool offset = offsets && offsets_live(s);
     for (size_t j = 0; j < n; ++j) {
         quat r = nlerp(source_.rotations[f0 + j], source_.rotations[f1 + j], s.frame_time);
         vec3 t = lerp(source_.translations[f0 + j], source_.translations[f1 + j], s.frame_time) * source_.metres_per_unit;
@@ -112,12 +134,39 @@ void MatchingController::sample(const MatchingState& s, LocalPoseOutput out, boo
             t = apply_planar(world, t);
             r = quat_mul(planar_rotation(world), r);
         }
-        if (decay > 0.0f) {
-            r = quat_mul(nlerp(quat_identity(), s.offset_rotation[j], decay), r);
-            t += s.offset_translation[j] * decay;
+        if (offset) {
+            r = quat_normalize(quat_mul(from_rotation_vector(s.offset_rotation[j]), r));
+            t += s.offset_translation[j];
         }
         out.rotations[j] = r;
         out.translations[j] = t;
+    }
+}
+
+void MatchingController::frame_velocities(const MatchingState& s, std::span<vec3> angular, std::span<vec3> linear) const {
+    const size_t n = static_cast<size_t>(db_.joint_count);
+    const size_t f0 = static_cast<size_t>(db_.source_frame[static_cast<size_t>(s.frame)]) * n;
+    const size_t f1 = (s.frame + 1 < db_.clip_end[static_cast<size_t>(s.frame)]
+                           ? static_cast<size_t>(db_.source_frame[static_cast<size_t>(s.frame) + 1]) : f0 / n) * n;
+    const float rate = static_cast<float>(db_.frame_rate);
+    const quat world = planar_rotation({s.world_angle, s.world_dx, s.world_dz});
+    for (size_t j = 0; j < n; ++j) {
+        const quat step = quat_mul(source_.rotations[f1 + j], quat_conjugate(source_.rotations[f0 + j]));
+        vec3 w = rotation_vector(step) * rate;
+        vec3 v = (source_.translations[f1 + j] - source_.translations[f0 + j]) * (source_.metres_per_unit * rate);
+        if (j == 0) w = quat_rotate(world, w), v = quat_rotate(world, v);
+        angular[j] = w;
+        linear[j] = v;
+    }
+}
+
+void MatchingController::decay_offsets(MatchingState& s, float dt) const {
+    if (!offsets_live(s)) return;
+    const float y = 2.0f * kLn2 / (config_.inertialization_s / 3.0f);
+    const float e = approx_negexp(y * dt);
+    for (size_t j = 0; j < static_cast<size_t>(db_.joint_count); ++j) {
+        decay_spring(s.offset_rotation[j], s.offset_angular_velocity[j], y, e, dt);
+        decay_spring(s.offset_translation[j], s.offset_velocity[j], y, e, dt);
     }
 }
 
@@ -177,6 +226,12 @@ float MatchingController::trajectory_departure(const MatchingState& s, const Tra
 void MatchingController::jump(MatchingState& s, int frame) {
     const size_t n = static_cast<size_t>(db_.joint_count);
     sample(s, {shown_rotations_, shown_translations_}, true);
+    // The shown pose's velocity: the old frame's plus its offsets' (their sum, as Holden's inertialization).
+    frame_velocities(s, old_angular_, old_linear_);
+    const bool live = offsets_live(s);
+    for (size_t j = 0; j < n; ++j) {
+        if (live) old_angular_[j] += s.offset_angular_velocity[j], old_linear_[j] += s.offset_velocity[j];
+    }
     const vec3 r = root_position(s);
     const float h = root_heading(s);
     s.frame = frame;
@@ -186,17 +241,17 @@ void MatchingController::jump(MatchingState& s, int frame) {
     const PlanarTransform w = placement(root_position(clip_only), root_heading(clip_only), r, h);
     s.world_angle = w.angle, s.world_dx = w.dx, s.world_dz = w.dz;
     s.since_jump = 0.0f;
-    // Offsets: shown pose = offset · new pose (rotations), shown − new (translations).
-    MatchingState bare = s;
-    bare.since_jump = 1e6f;
+    // Offsets: shown pose = exp(offset) · new pose (rotations), shown − new
+    // (translations); their velocities: the shown pose's − the new frame's.
     std::array<quat, kMatchMaxJoints> rot{};
-    std::array<vec3, kMatchMaxJoints> tr{};
-    sample(bare, {std::span<quat>(rot.data(), n), std::span<vec3>(tr.data(), n)}, false);
+    std::array<vec3, kMatchMaxJoints> tr{}, new_angular{}, new_linear{};
+    sample(s, {std::span<quat>(rot.data(), n), std::span<vec3>(tr.data(), n)}, false);
+    frame_velocities(s, std::span<vec3>(new_angular.data(), n), std::span<vec3>(new_linear.data(), n));
     for (size_t j = 0; j < n; ++j) {
-        quat o = quat_mul(shown_rotations_[j], quat_conjugate(rot[j]));
-        if (o.w < 0.0f) o = quat(-o.w, -o.x, -o.y, -o.z);
-        s.offset_rotation[j] = quat_normalize(o);
+        s.offset_rotation[j] = rotation_vector(quat_normalize(quat_mul(shown_rotations_[j], quat_conjugate(rot[j]))));
+        s.offset_angular_velocity[j] = old_angular_[j] - new_angular[j];
         s.offset_translation[j] = shown_translations_[j] - tr[j];
+        s.offset_velocity[j] = old_linear_[j] - new_linear[j];
     }
     ++s.jumps;
 }
@@ -217,6 +272,7 @@ bool MatchingController::step(MatchingState& s, const MatchingInput& in, LocalPo
             break;
         }
     }
+    decay_offsets(s, in.dt);
     correct_root(s, in.dt);
     s.since_search += in.dt;
     s.since_jump += in.dt;

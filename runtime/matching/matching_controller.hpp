@@ -13,9 +13,11 @@
 //     the database is searched (search_matching_accelerated) for the frame whose
 //     features best match the current frame's with the desired trajectory, and
 //     the character jumps there;
-//   - every jump is inertialized: the offsets between the pose shown and the new
-//     frame decay to zero over `inertialization_s` along a cubic (1 − 3u² + 2u³),
-//     so the pose never jumps.
+//   - every jump is inertialized (Bollo; Holden): the offsets between the pose
+//     shown and the new frame (per joint a rotation vector and a translation) and
+//     the offsets' velocities (the shown pose's velocity − the new frame's) decay
+//     to zero as critically damped springs of halflife `inertialization_s` / 3,
+//     so neither the pose nor its velocity jumps.
 // The state is plain fixed-size data (it lives in PuppetState and is hashed);
 // the controller holds the database and its scratch, sized at construction, so
 // step() never allocates.
@@ -37,7 +39,7 @@ inline constexpr int kMatchMaxJoints = 64;
 struct MatchingControllerConfig {
     float search_interval_s = 0.1f;        // a search at least this often
     float search_threshold_m = 0.15f;      // … and whenever the desired trajectory is this far from the frame's
-    float inertialization_s = 0.25f;       // a jump's offsets decay over this long
+    float inertialization_s = 0.25f;       // a jump's offsets decay with halflife inertialization_s / 3
     float velocity_halflife_s = 0.12f;     // desired velocity spring
     float facing_halflife_s = 0.15f;       // desired facing spring
     float correction_halflife_s = 0.08f;   // the root is pulled toward the spring with this halflife
@@ -49,12 +51,17 @@ struct MatchingState {
     double world_angle = 0.0, world_dx = 0.0, world_dz = 0.0;  // clip (metres) → world placement
     TrajectorySpring spring{};       // the desired trajectory's present
     float since_search = 0.0f;       // seconds since the last search
-    float since_jump = 1e6f;         // seconds since the last jump (inertialization clock)
+    float since_jump = 1e6f;         // seconds since the last jump (offsets are zero from 4 × inertialization_s)
     float last_cost = 0.0f;          // cost of the last search's answer
     std::uint8_t contacts = 0;       // foot contacts of the frame played
     std::int64_t searches = 0, jumps = 0;
-    std::array<quat, kMatchMaxJoints> offset_rotation{};     // pose shown = offset · frame's pose, decaying
+    // Pose shown = exp(offset_rotation) · frame's rotation (a rotation vector, radians,
+    // in the joint's parent frame; the root's in the world), frame's translation +
+    // offset_translation; each with its velocity (rad/s, m/s), decaying as springs.
+    std::array<vec3, kMatchMaxJoints> offset_rotation{};
+    std::array<vec3, kMatchMaxJoints> offset_angular_velocity{};
     std::array<vec3, kMatchMaxJoints> offset_translation{};
+    std::array<vec3, kMatchMaxJoints> offset_velocity{};
 };
 
 struct MatchingInput {
@@ -96,6 +103,11 @@ public:
 private:
     bool valid(const MatchingState& s, LocalPoseOutput pose) const;
     void sample(const MatchingState& s, LocalPoseOutput out, bool offsets) const;
+    // Per joint: the frame's angular velocity (rad/s, as the offsets: parent frame,
+    // root in the world) and translation velocity (m/s), from the frame to the next.
+    void frame_velocities(const MatchingState& s, std::span<vec3> angular, std::span<vec3> linear) const;
+    void decay_offsets(MatchingState& s, float dt) const;
+    bool offsets_live(const MatchingState& s) const { return s.since_jump < 4.0f * config_.inertialization_s; }
     void correct_root(MatchingState& s, float dt) const;
     void desired_features(const MatchingState& s, const TrajectoryGoal& goal, std::span<float> raw) const;
     void jump(MatchingState& s, int frame);
@@ -105,6 +117,7 @@ private:
     MatchingControllerConfig config_;
     std::vector<quat> shown_rotations_;     // the pose shown before a jump
     std::vector<vec3> shown_translations_;
+    std::vector<vec3> old_angular_, old_linear_;  // the old frame's velocities at a jump
 };
 
 }  // namespace marionette

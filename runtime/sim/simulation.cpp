@@ -123,8 +123,10 @@ void hash_matching(HashBytes& h, const MatchingState& m, const FootPlacementStat
     const std::int64_t counters[2] = {m.searches, m.jumps};
     h.add(counters, sizeof counters);
     for (size_t j = 0; j < joints && j < m.offset_rotation.size(); ++j) {
-        hash_quat(h, m.offset_rotation[j]);
+        hash_vec(h, m.offset_rotation[j]);
+        hash_vec(h, m.offset_angular_velocity[j]);
         hash_vec(h, m.offset_translation[j]);
+        hash_vec(h, m.offset_velocity[j]);
     }
     for (const FootPin& p : feet.feet) {
         hash_vec(h, p.pin);

@@ -99,6 +99,7 @@ TEST_CASE("a log whose clip data differ from this build is refused", "[golden]")
 // directory (scripts/update-golden.sh copies them over).
 #include <cstdlib>
 #include <fstream>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <xxhash.h>
@@ -142,6 +143,16 @@ TEST_CASE("replays driven by the default motion graph match the committed golden
         {"graph_actions", test::source_path("config/programs/actions.prog"), "graph", "flat", {}},
         {"graph_feet_circle_stairs", "builtin:circle", "graph_feet", "stairs", {}},
         {"graph_switch_stairs", "builtin:demo", "gait", "stairs", {{480, "graph_feet"}, {1440, "gait"}}},
+        // Motion matching (docs/motion-matching.md) on the database the default
+        // graph's locomotion clips make: the whole demo on stairs (search, jumps,
+        // inertialization, foot placement and the look-ahead lift), and live
+        // switches gait → matching → graph_feet → matching → gait on the slope.
+        {"matching_demo_stairs", "builtin:demo", "matching", "stairs", {}},
+        {"matching_switch_slope",
+         "builtin:demo",
+         "gait",
+         "slope",
+         {{480, "matching"}, {1440, "graph_feet"}, {2400, "matching"}, {3360, "gait"}}},
     };
     for (const GraphGolden& c : cases) {
         INFO("golden " << c.name);
@@ -169,6 +180,12 @@ TEST_CASE("replays driven by the default motion graph match the committed golden
             }
             sim.step(ticks[k]);
             recorded.push_back(hash_state(sim.state()));
+        }
+        if (std::string_view(c.name).starts_with("matching")) {
+            // The trace covers searches and inertialized jumps, not one clip played through.
+            INFO("matching searches " << sim.state().matching.searches << ", jumps " << sim.state().matching.jumps);
+            CHECK(sim.state().matching.jumps >= 10);
+            CHECK(sim.state().matching.searches > sim.state().matching.jumps);
         }
         const std::string trace_path = fmt::format("golden_{}.csv", c.name);
         ReplayOptions options;

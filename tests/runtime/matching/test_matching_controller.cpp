@@ -73,9 +73,8 @@ TEST_CASE("matching controller: follows speed and heading, jumps without pops, a
         CHECK(std::fabs(det::wrap_angle(mc.root_heading(s) - heading)) < 0.2);
         CHECK(s.searches > 30);
         // The root's motion per tick changes by under 6 mm from one tick to the next:
-        // jumps are inertialized, so the root never jumps by a position offset. The
-        // offsets decay along a cubic that starts flat, so the velocity change of a
-        // jump (up to ~4 mm/tick between these random clips) is not hidden yet.
+        // jumps are inertialized, so the root never jumps by a position offset (nor,
+        // since the offsets carry the velocity difference, by a velocity).
         CHECK(worst_root_jerk < 0.006);
     }
 }
@@ -97,4 +96,60 @@ TEST_CASE("matching controller: identical inputs give identical states", "[match
     CHECK(s1.world_dx == s2.world_dx);
     CHECK(s1.jumps == s2.jumps);
     CHECK(s1.jumps > 0);
+}
+
+// Velocity inertialization (docs/motion-matching.md): on a jump the offset to the
+// new frame and the offset's velocity (shown pose's − new frame's) decay as
+// critically damped springs, so a jump adds no joint-speed spike beyond what
+// the clips themselves move, and the joints' velocity does not step at a jump.
+// Generated stick changes (fixed seed) over the fixture's speeds and turns.
+TEST_CASE("matching controller: a jump adds no joint-speed spike beyond the clips' own", "[matching]") {
+    Rig rig;
+    const MatchingSource source = rig.fixture.source();
+    const size_t n = 7;
+    // The clips' own fastest joint (local rotation, not the root), frame to frame.
+    double clip_speed = 0.0;
+    for (const MatchingClipRange& c : rig.fixture.clips)
+        for (int f = c.first_frame; f + 1 < c.first_frame + c.frame_count; ++f)
+            for (size_t j = 1; j < n; ++j)
+                clip_speed = std::max(clip_speed, quat_angle_between(source.rotations[static_cast<size_t>(f) * n + j],
+                                                                     source.rotations[static_cast<size_t>(f + 1) * n + j]) * source.frame_rate);
+    REQUIRE(clip_speed > 1.0);
+    MatchingController mc(source, rig.db, {});
+    std::uint64_t rng = 7;
+    const float dt = 1.0f / 240.0f;
+    double worst_speed = 0.0, worst_jump_step = 0.0, worst_steady_step = 0.0;
+    std::int64_t jumps = 0;
+    for (int trial = 0; trial < 8; ++trial) {
+        MatchingState s = mc.initial_state(vec3(0.0f), 0.0f);
+        std::array<quat, 7> r{}, previous{};
+        std::array<vec3, 7> t{};
+        std::array<double, 7> previous_speed{};
+        MatchingInput in;
+        in.dt = dt;
+        for (int tick = 0; tick < 240 * 6; ++tick) {
+            if (tick % 120 == 0) in.goal = goal_of(0.2 + 2.6 * test::fixture_unit(rng), (test::fixture_unit(rng) * 2.0 - 1.0) * 3.0);
+            const std::int64_t before = s.jumps;
+            REQUIRE(mc.step(s, in, {r, t}));
+            if (tick >= 2) {
+                for (size_t j = 1; j < n; ++j) {
+                    const double speed = quat_angle_between(previous[j], r[j]) / dt;
+                    worst_speed = std::max(worst_speed, speed);
+                    const double step = std::fabs(speed - previous_speed[j]);  // rad/s per tick
+                    (s.jumps != before ? worst_jump_step : worst_steady_step) =
+                        std::max(s.jumps != before ? worst_jump_step : worst_steady_step, step);
+                    previous_speed[j] = speed;
+                }
+            } else {
+                for (size_t j = 1; j < n; ++j) previous_speed[j] = tick == 1 ? quat_angle_between(previous[j], r[j]) / dt : 0.0;
+            }
+            previous = r;
+        }
+        jumps += s.jumps;
+    }
+    INFO("clips' fastest joint " << clip_speed << " rad/s, shown " << worst_speed << " rad/s; speed step at a jump "
+                                 << worst_jump_step << ", elsewhere " << worst_steady_step << " rad/s per tick; " << jumps << " jumps");
+    CHECK(jumps > 100);
+    CHECK(worst_speed <= 1.05 * clip_speed);
+    CHECK(worst_jump_step <= 1.5 * worst_steady_step);
 }
