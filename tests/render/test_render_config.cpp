@@ -80,3 +80,29 @@ TEST_CASE("every render setting is documented in docs/render.md", "[render][conf
         CHECK(doc.find("[" + k.table + "]") != std::string::npos);
     }
 }
+
+TEST_CASE("[render] character and the [character] role map: paths, roles and errors", "[render][config][character]") {
+    const RenderConfig base = load_render_config("");
+    CHECK(base.character.empty());  // the capsule puppet is the default
+    // A relative path is resolved against the folder of the file that names it.
+    const RenderConfig rc = apply_render_config_text(base,
+                                                     "[render]\ncharacter = \"chars/me.glb\"\n"
+                                                     "[character]\nthigh_l = \"LeftUpLeg\"\nhead = \"Head\"\n",
+                                                     "/etc/marionette/render.toml");
+    CHECK(rc.character == "/etc/marionette/chars/me.glb");
+    REQUIRE(rc.character_map.size() == 2);
+    CHECK(rc.character_map[0] == std::pair<std::string, std::string>("thigh_l", "LeftUpLeg"));
+    CHECK(rc.character_map_lines[1] == 5);
+    CHECK(apply_render_config_text(base, "[render]\ncharacter = \"/abs/c.gltf\"\n", "x/render.toml").character == "/abs/c.gltf");
+    try {
+        apply_render_config_text(base, "[character]\nknee_l = \"LeftLeg\"\n", "mine.toml");
+        FAIL("an unknown role was accepted");
+    } catch (const ConfigError& e) {
+        const std::string what = e.what();
+        CHECK(what.find("mine.toml:2") != std::string::npos);
+        CHECK(what.find("character.knee_l") != std::string::npos);
+        CHECK(what.find("unknown role") != std::string::npos);
+    }
+    CHECK_THROWS_AS(apply_render_config_text(base, "[character]\nhead = 3\n", "mine.toml"), ConfigError);
+    CHECK_THROWS_AS(apply_render_config_text(base, "[render]\ncharacter = 3\n", "mine.toml"), ConfigError);
+}
