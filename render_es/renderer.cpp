@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <cstring>
 #include <initializer_list>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "render_es/gl_util.hpp"
@@ -68,8 +70,27 @@ void set_colours(GLuint program, const char* name, const vec3* colours, int coun
 }
 }  // namespace
 
-Renderer::Renderer(const Skeleton& skeleton, const Terrain& terrain, const RenderSettings& settings)
-    : settings_(settings), parents_(skeleton.parents), puppet_(make_capsule_mesh(skeleton)),
+namespace {
+SkinnedMesh body_mesh(const Skeleton& skeleton, const SkinnedMesh* body) {
+    if (!body) return make_capsule_mesh(skeleton);
+    if (body->inverse_bind.size() != static_cast<std::size_t>(skeleton.joint_count()) || body->vertices.empty() ||
+        body->vertices.size() > 65535)
+        throw std::invalid_argument("the character mesh does not fit the skeleton (" +
+                                    std::to_string(body->inverse_bind.size()) + " inverse binds for " +
+                                    std::to_string(skeleton.joint_count()) + " joints, " +
+                                    std::to_string(body->vertices.size()) + " vertices)");
+    for (const SkinnedVertex& v : body->vertices)
+        for (std::uint8_t j : v.joints)
+            if (j >= body->inverse_bind.size()) throw std::invalid_argument("the character mesh names a joint the skeleton lacks");
+    for (std::uint16_t i : body->indices)
+        if (i >= body->vertices.size()) throw std::invalid_argument("the character mesh has an index out of range");
+    return *body;
+}
+}  // namespace
+
+Renderer::Renderer(const Skeleton& skeleton, const Terrain& terrain, const RenderSettings& settings,
+                   const SkinnedMesh* body)
+    : settings_(settings), parents_(skeleton.parents), puppet_(body_mesh(skeleton, body)),
       terrain_(make_terrain_mesh(terrain)) {
     toggles_.skeleton = settings.show_skeleton;
     toggles_.feet = settings.show_feet;

@@ -24,7 +24,11 @@ namespace marionette::render {
 class Renderer {
 public:
     // Needs a current GLES 3 context. Throws ShaderError (naming the shader).
-    Renderer(const Skeleton& skeleton, const Terrain& terrain, const RenderSettings& settings);
+    // `body` (optional, copied): a skinned mesh bound to the skeleton's joints
+    // drawn instead of the capsules (a glTF character, character/); it must have
+    // one inverse bind per joint. Throws std::invalid_argument when it does not.
+    Renderer(const Skeleton& skeleton, const Terrain& terrain, const RenderSettings& settings,
+             const SkinnedMesh* body = nullptr);
     ~Renderer();
     Renderer(const Renderer&) = delete;
     Renderer& operator=(const Renderer&) = delete;

@@ -6,10 +6,10 @@
 namespace marionette::render {
 
 View::View(const PlatformOptions& platform, const RenderSettings& settings, const Skeleton& skeleton,
-           const Terrain& terrain)
+           const Terrain& terrain, const SkinnedMesh* body)
     : platform_(open_platform(platform)) {
     platform_->begin_frame();
-    renderer_ = std::make_unique<Renderer>(skeleton, terrain, settings);
+    renderer_ = std::make_unique<Renderer>(skeleton, terrain, settings, body);
 }
 
 FrameResult View::frame(const PuppetState& state, const DebugOverlay& overlay, std::string_view hud_text, float dt_s) {

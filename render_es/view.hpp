@@ -36,7 +36,9 @@ struct FrameResult {
 class View {
 public:
     // Throws PlatformError or ShaderError.
-    View(const PlatformOptions& platform, const RenderSettings& settings, const Skeleton& skeleton, const Terrain& terrain);
+    // `body`: drawn instead of the capsules when given (Renderer's constructor).
+    View(const PlatformOptions& platform, const RenderSettings& settings, const Skeleton& skeleton, const Terrain& terrain,
+         const SkinnedMesh* body = nullptr);
 
     // Polls events (applying the overlay toggles), draws, presents. Throws
     // PlatformError only when recovery from a lost context fails.

@@ -106,7 +106,15 @@ Found find_limbs(const Rest& r, const std::string& file) {
     for (int l : leaves) {
         if (l == f.head_leaf) continue;
         int start = l;
-        while (!on_spine[static_cast<size_t>(r.s->parents[static_cast<size_t>(start)])]) start = r.s->parents[static_cast<size_t>(start)];
+        // A leaf of another tree (a skeleton with two roots) never meets the spine.
+        for (;;) {
+            const int p = r.s->parents[static_cast<size_t>(start)];
+            if (p == kNoParent)
+                not_humanoid(file, "leaf '" + r.s->joint_names[static_cast<size_t>(l)] +
+                                       "' is not in the head's tree (the skeleton has more than one root)");
+            if (on_spine[static_cast<size_t>(p)]) break;
+            start = p;
+        }
         auto it = std::find_if(limbs.begin(), limbs.end(), [&](const Limb& m) { return m.start == start; });
         if (it == limbs.end()) {
             Limb m;

@@ -16,6 +16,9 @@ packages=(
   libegl-dev libgles-dev libgbm-dev libdrm-dev libseat-dev libstb-dev libegl-mesa0 libgl1-mesa-dri xvfb xauth
   # the in-app tuning UI (app/ui/, docs/ui.md): Dear ImGui 1.86, static library and headers
   libimgui-dev
+  # your own character (render_es/character/, docs/render.md): glTF 2.0 loading,
+  # header-only tinygltf and the JSON library it uses
+  libtinygltf-dev nlohmann-json3-dev
   # motion graph: BLAS for the distance matrix
   libopenblas-dev
   # key-pose graphs saved and loaded as XML (graph_builder/key_pose_xml.cpp)

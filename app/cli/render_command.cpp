@@ -16,6 +16,7 @@
 #include "app/io/log.hpp"
 #include "app/config/config.hpp"
 #include "app/io/files.hpp"
+#include "app/config/character_config.hpp"
 #include "app/config/render_config.hpp"
 #include "app/eval/log_provenance.hpp"
 #include "app/eval/replay.hpp"
@@ -137,6 +138,7 @@ int render_command(const RenderCommandOptions& o) {
     platform.msaa_samples = rc.settings.msaa_samples;
     const Terrain* terrain = nullptr;  // the replayed simulation's
 
+    std::shared_ptr<const render::SkinnedMesh> body;  // [render] character, loaded with the first tick
     std::unique_ptr<render::View> view;
     std::unique_ptr<VideoPipe> video;
     PuppetState previous;
@@ -173,7 +175,8 @@ int render_command(const RenderCommandOptions& o) {
             tick_rate = sim.config().tick_rate_hz;
             ankle_height = sim.config().ankle_height;
             terrain = &sim.terrain();
-            view = std::make_unique<render::View>(platform, rc.settings, sim.skeleton(), *terrain);
+            body = load_render_character(rc, sim.skeleton());
+            view = std::make_unique<render::View>(platform, rc.settings, sim.skeleton(), *terrain, body.get());
             if (!ffmpeg.empty()) video = std::make_unique<VideoPipe>(ffmpeg, o.video, platform.width, platform.height, o.fps);
         }
         // Every frame whose time falls in (previous tick, this tick] is drawn now.

@@ -23,6 +23,8 @@
 #include "app/live/recording.hpp"
 #include "app/config/program_source.hpp"
 #include "app/config/embedded.hpp"
+#include "app/config/character_config.hpp"
+#include "runtime/gait/puppet.hpp"
 #include "app/config/render_config.hpp"
 #include "input/evdev/evdev_backend.hpp"
 #include "input/hid/hidapi_transport.hpp"
@@ -197,6 +199,7 @@ render::PlatformKind prepare_display(const RunOptions& o, const ConfigSearchDirs
     fmt::print("marionette: render settings: {}\n", describe_config_lookup(render_found));
     p.display.gl = true;
     p.display.settings = rc.settings;
+    p.display.body = load_render_character(rc, make_puppet_skeleton(p.config));
     p.display.platform.kind = kind;
     p.display.platform.width = rc.settings.width;
     p.display.platform.height = rc.settings.height;

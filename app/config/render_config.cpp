@@ -2,12 +2,14 @@
 
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <functional>
 
 #include "app/config/embedded.hpp"
 #include "app/io/files.hpp"
+#include "retarget/humanoid.hpp"
 #include "runtime/errors/outcome.hpp"
 
 namespace marionette {
@@ -70,6 +72,9 @@ const std::vector<RenderKey>& keys() {
         {"overlays", "hud", Kind::boolean, 0, 1, "text HUD shown at start (key H)", bool_field(&S::show_hud)},
         {"kms", "device", Kind::text, 0, 0, "DRM device node; empty picks the first with a connected display",
          [](RenderConfig& c, double, const vec3&, const std::string& t) { c.drm_device = t; return Outcome::success(); }},
+        {"render", "character", Kind::text, 0, 0,
+         "skinned glTF 2.0 character (.gltf/.glb) drawn instead of the capsules; empty: the capsules; relative to this file's folder",
+         [](RenderConfig& c, double, const vec3&, const std::string& t) { c.character = t; return Outcome::success(); }},
         {"kms", "connector", Kind::text, 0, 0, "connector name such as HDMI-A-1; empty picks the first connected",
          [](RenderConfig& c, double, const vec3&, const std::string& t) { c.kms.connector = t; return Outcome::success(); }},
         {"kms", "mode", Kind::text, 0, 0, "forced mode WIDTHxHEIGHT or WIDTHxHEIGHT@HZ; empty chooses by policy",
@@ -95,6 +100,27 @@ std::string number_text(double v) {
     char buf[32];
     const auto r = std::to_chars(buf, buf + sizeof buf, v);
     return std::string(buf, r.ptr);
+}
+
+// `[character]`: role = "joint name" lines (the roles of retarget/humanoid.hpp).
+void read_character_map(const toml::node& table_node, const std::string& file, RenderConfig& config) {
+    const toml::table* table = table_node.as_table();
+    if (!table) throw ConfigError(file, line_of(table_node), "character", "expected a table ([character])");
+    config.character_map.clear();
+    config.character_map_lines.clear();
+    config.character_origin = file;
+    for (const auto& [key, node] : *table) {
+        const std::string role(key.str());
+        const auto& names = retarget::role_names();
+        if (std::find_if(names.begin(), names.end(), [&](const char* n) { return role == n; }) == names.end())
+            throw ConfigError(file, line_of(node), "character." + role,
+                              "unknown role (expected a puppet joint name: pelvis, spine_01, ..., toe_r; docs/render.md)");
+        const auto* v = node.as_string();
+        if (!v || v->get().empty())
+            throw ConfigError(file, line_of(node), "character." + role, "expected the character's joint name as a non-empty string");
+        config.character_map.emplace_back(role, v->get());
+        config.character_map_lines.push_back(line_of(node));
+    }
 }
 
 const char* kind_name(Kind k) {
@@ -145,11 +171,16 @@ RenderConfig apply_render_config_text(const RenderConfig& base, std::string_view
     RenderConfig config = base;
     for (const auto& [table_key, table_node] : doc) {
         const std::string table_name(table_key.str());
+        if (table_name == "character") {
+            read_character_map(table_node, file, config);
+            continue;
+        }
         std::string known;
         for (const RenderKey& k : keys())
             if (table_name == k.table) known += (known.empty() ? "" : ", ") + std::string(k.key);
         if (known.empty())
-            throw ConfigError(file, line_of(table_node), table_name, "unknown table (expected display, camera, colours, overlays or kms)");
+            throw ConfigError(file, line_of(table_node), table_name,
+                              "unknown table (expected display, camera, colours, overlays, kms, render or character)");
         const toml::table* table = table_node.as_table();
         if (!table) throw ConfigError(file, line_of(table_node), table_name, "expected a table ([" + table_name + "])");
         for (const auto& [key, node] : *table) {
@@ -208,6 +239,10 @@ RenderConfig apply_render_config_text(const RenderConfig& base, std::string_view
             }
             if (const Outcome stored = spec->set(config, number, colour, string_value); !stored.ok())
                 throw ConfigError(file, line_of(node), full, stored.problem());
+            if (full == "render.character" && !string_value.empty() && string_value.front() != '/') {
+                const std::size_t slash = file.find_last_of('/');
+                if (slash != std::string::npos) config.character = file.substr(0, slash + 1) + string_value;
+            }
         }
     }
     return config;

@@ -15,6 +15,14 @@ struct RenderConfig {
     render::RenderSettings settings;
     std::string drm_device;
     render::KmsModeRequest kms;
+    // Your own character (docs/render.md): `[render] character`, a .gltf/.glb
+    // file drawn instead of the capsules ("" keeps the capsules), resolved against
+    // the directory of the file that names it; `[character]` names skeleton roles
+    // outright (role = "joint"), one entry per line of that table.
+    std::string character;
+    std::string character_origin;  // the render config file that named the map entries
+    std::vector<std::pair<std::string, std::string>> character_map;
+    std::vector<int> character_map_lines;
 };
 
 // Every key, as "table.key", with its documentation (docs/render.md lists each; a test checks).

@@ -426,7 +426,8 @@ void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, Ren
     std::unique_ptr<render::View> view;
     if (in.display->gl) {
         try {
-            view = std::make_unique<render::View>(in.display->platform, in.display->settings, *in.skeleton, terrain);
+            view = std::make_unique<render::View>(in.display->platform, in.display->settings, *in.skeleton, terrain,
+                                                 in.display->body.get());
             display.description = view->platform().description();
             display.state.store(DisplayThreadState::ready, std::memory_order_release);
         } catch (const std::exception& e) {

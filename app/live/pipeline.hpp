@@ -20,6 +20,7 @@
 #include "app/config/app_config.hpp"
 #include "app/live/recording.hpp"
 #include "app/ui/pad_presses.hpp"
+#include "render_es/mesh.hpp"
 #include "render_es/platform.hpp"
 #include "render_es/settings.hpp"
 #include "runtime/formats/input_log.hpp"
@@ -272,6 +273,8 @@ struct DisplayOptions {
     bool gl = false;
     render::PlatformOptions platform;
     render::RenderSettings settings;
+    // `[render] character` loaded (app/config/character_config.hpp); null: capsules.
+    std::shared_ptr<const render::SkinnedMesh> body;
 };
 
 namespace input {

@@ -28,6 +28,20 @@ expect_error "unknown overlay" 2 "unknown overlay 'bones'" "$bin" render walk.ml
 printf '[display]\nmsaa_samples = 99\n' >bad_render.toml
 expect_error "bad render settings name file, line and key" 2 "bad_render.toml:2: display.msaa_samples" \
   "$bin" render walk.mlog --out x --render-config bad_render.toml
+# [render] character: the shipped glTF character draws (relative to the settings
+# file's folder); a missing or truncated file exits 2 naming it.
+mkdir -p chars
+cp "$src/config/characters/blocky.gltf" chars/
+printf '[render]\ncharacter = "blocky.gltf"\n' >chars/character.toml
+"$bin" render walk.mlog --out character --size 320x200 --fps 2 --from 5 --to 5 --render-config chars/character.toml >character.txt
+check "render with [render] character writes its frame" test -f character/frame_00000.png
+head -c 4000 "$src/config/characters/blocky.gltf" >chars/cut.gltf
+printf '[render]\ncharacter = "cut.gltf"\n' >chars/cut.toml
+expect_error "a truncated glTF character names the file" 2 "chars/cut.gltf: not a readable glTF file" \
+  "$bin" render walk.mlog --out x --render-config chars/cut.toml
+printf '[render]\ncharacter = "nobody.glb"\n' >chars/missing.toml
+expect_error "a missing glTF character names the file" 2 "chars/nobody.glb: cannot open the file" \
+  "$bin" render walk.mlog --out x --render-config chars/missing.toml
 printf 'garbage' >bad.mlog
 expect_error "a malformed log" 2 "bad.mlog" "$bin" render bad.mlog --out x
 if ! command -v ffmpeg >/dev/null; then

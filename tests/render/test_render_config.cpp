@@ -80,3 +80,35 @@ TEST_CASE("every render setting is documented in docs/render.md", "[render][conf
         CHECK(doc.find("[" + k.table + "]") != std::string::npos);
     }
 }
+
+TEST_CASE("[render] character and the [character] role map: paths, roles and errors", "[render][config][character]") {
+    const RenderConfig base = load_render_config("");
+    CHECK(base.character.empty());  // the capsule puppet is the default
+    // A relative path is resolved against the folder of the file that names it.
+    const RenderConfig rc = apply_render_config_text(base,
+                                                     "[render]\ncharacter = \"chars/me.glb\"\n"
+                                                     "[character]\nthigh_l = \"LeftUpLeg\"\nhead = \"Head\"\n",
+                                                     "/etc/marionette/render.toml");
+    CHECK(rc.character == "/etc/marionette/chars/me.glb");
+    REQUIRE(rc.character_map.size() == 2);
+    REQUIRE(rc.character_map_lines.size() == 2);
+    // toml++ gives a table's keys in its own order: look each role up.
+    for (std::size_t i = 0; i < 2; ++i) {
+        const auto& [role, joint] = rc.character_map[i];
+        CHECK(joint == (role == "thigh_l" ? "LeftUpLeg" : "Head"));
+        CHECK(rc.character_map_lines[i] == (role == "thigh_l" ? 4 : 5));
+    }
+    CHECK(rc.character_origin == "/etc/marionette/render.toml");
+    CHECK(apply_render_config_text(base, "[render]\ncharacter = \"/abs/c.gltf\"\n", "x/render.toml").character == "/abs/c.gltf");
+    try {
+        apply_render_config_text(base, "[character]\nknee_l = \"LeftLeg\"\n", "mine.toml");
+        FAIL("an unknown role was accepted");
+    } catch (const ConfigError& e) {
+        const std::string what = e.what();
+        CHECK(what.find("mine.toml:2") != std::string::npos);
+        CHECK(what.find("character.knee_l") != std::string::npos);
+        CHECK(what.find("unknown role") != std::string::npos);
+    }
+    CHECK_THROWS_AS(apply_render_config_text(base, "[character]\nhead = 3\n", "mine.toml"), ConfigError);
+    CHECK_THROWS_AS(apply_render_config_text(base, "[render]\ncharacter = 3\n", "mine.toml"), ConfigError);
+}

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <vector>
 
+#include "app/config/character_config.hpp"
 #include "app/config/config.hpp"
 #include "app/config/program_source.hpp"
 #include "app/config/render_config.hpp"
@@ -258,6 +259,34 @@ TEST_CASE("a frame allocates nothing once the view is open", "[render][alloc]") 
     const std::uint64_t before = test::allocation_count();
     for (int i = 0; i < 8; ++i)
         for (const PuppetState& s : r.states) view.frame(s, overlay, "tick 123  speed 1.00 m/s", 1.0f / 60.0f);
+    CHECK(test::allocation_count() - before == 0);
+}
+
+// The shipped glTF character (config/characters/blocky.gltf, made by
+// scripts/generate-character.py) drawn GPU-skinned in place of the capsules, in
+// the walk_stop golden's pose: a golden of its own, visibly not the capsules, and
+// still no allocation per frame.
+TEST_CASE("golden image: the shipped glTF character walks in place of the capsules", "[render][golden][character]") {
+    RenderConfig rc = load_render_config("");
+    rc.character = test::source_path("config/characters/blocky.gltf");
+    render::RenderSettings settings = rc.settings;
+    settings.show_hud = false;
+    const Replayed r = replay_ticks("walk_stop", {600, 601, 602});
+    const std::shared_ptr<const render::SkinnedMesh> body = load_render_character(rc, r.skeleton);
+    REQUIRE(body);
+    render::View view(golden_platform(), settings, r.skeleton, r.terrain, body.get());
+    CHECK(view.renderer().puppet_triangle_count() == 20 * 12);
+    view.frame(r.states[0], render::DebugOverlay{}, "", 1.0f / 60.0f);
+    const render::Image image = snapshot(view);
+    check_golden("character_walk_stop_t600", image);
+    render::View capsules(golden_platform(), settings, r.skeleton, r.terrain);
+    capsules.frame(r.states[0], render::DebugOverlay{}, "", 1.0f / 60.0f);
+    CHECK(render::compare_images(snapshot(capsules), image, kChannelTolerance).differing_pixels > 300);
+
+    for (const PuppetState& s : r.states) view.frame(s, render::DebugOverlay{}, "warm-up", 1.0f / 60.0f);
+    const std::uint64_t before = test::allocation_count();
+    for (int i = 0; i < 4; ++i)
+        for (const PuppetState& s : r.states) view.frame(s, render::DebugOverlay{}, "tick 600", 1.0f / 60.0f);
     CHECK(test::allocation_count() - before == 0);
 }
 
