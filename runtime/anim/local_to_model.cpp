@@ -3,6 +3,10 @@
 #include <cstdint>
 #include <cstring>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace marionette::fk {
 
 void local_to_model_scalar(std::span<const int> parents, const LocalPoseInput& input, const ModelPoseOutput& output) {
@@ -63,15 +67,25 @@ inline void store_quat(quat& q, f4 v) { std::memcpy(static_cast<void*>(&q), &v, 
 // position matches the parent's stores piece for piece, so the CPU forwards it
 // from the store buffer (a 16-byte load over an 8- and a 4-byte store cannot).
 inline f4 load_vec3(const vec3& v) {
+#if defined(__SSE2__)
+    const __m128 xy = _mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(&v.x)));
+    return f4(_mm_movelh_ps(xy, _mm_load_ss(&v.z)));
+#else
     const float* f = &v.x;
     return f4{f[0], f[1], f[2], 0.0f};
+#endif
 }
 
 inline void store_vec3(vec3& v, f4 r) {
+#if defined(__SSE2__)
+    _mm_store_sd(reinterpret_cast<double*>(&v.x), _mm_castps_pd(__m128(r)));
+    _mm_store_ss(&v.z, _mm_movehl_ps(__m128(r), __m128(r)));
+#else
     float* f = &v.x;
     f[0] = r[0];
     f[1] = r[1];
     f[2] = r[2];
+#endif
 }
 
 constexpr std::uint32_t kSign = 0x80000000u;
@@ -86,17 +100,21 @@ inline f4 mul(f4 a, f4 b) {
     return ((t1 + t2) + t3) + t4;
 }
 
-// u × v in lanes 0..2: (u.y*v.z - u.z*v.y, u.z*v.x - u.x*v.z, u.x*v.y - u.y*v.x).
-inline f4 cross(f4 u, f4 v) {
-    return MARIONETTE_SHUFFLE(u, 1, 2, 0, 3) * MARIONETTE_SHUFFLE(v, 2, 0, 1, 3) -
-           MARIONETTE_SHUFFLE(u, 2, 0, 1, 3) * MARIONETTE_SHUFFLE(v, 1, 2, 0, 3);
-}
+// The cross products below use the three-shuffle form: with s = (y, z, x)
+// shuffles, a*s(b) - s(a)*b holds (u×v).z, .x, .y in lanes 0, 1, 2, and
+// lane 1, for one, is u.y*v.z - u.z*v.y: the scalar component's own products
+// and subtraction. One more s() puts the lanes in x, y, z order.
+inline f4 yzx(f4 v) { return MARIONETTE_SHUFFLE(v, 1, 2, 0, 3); }
+inline f4 zxy(f4 v) { return MARIONETTE_SHUFFLE(v, 2, 0, 1, 3); }
 
 // quat_rotate(q, v) = (v + q.w*t) + u×t, t = 2*(u×v), u = q's vector part
-// (lanes 0..2 of q; cross() never reads lane 3).
+// (lanes 0..2 of q; lane 3 of every result is unused).
 inline f4 rotate(f4 q, f4 v) {
-    const f4 t = f4{2.0f, 2.0f, 2.0f, 2.0f} * cross(q, v);
-    return (v + splat(q, 3) * t) + cross(q, t);
+    const f4 q_yzx = yzx(q);
+    const f4 t_zxy = f4{2.0f, 2.0f, 2.0f, 2.0f} * (q * yzx(v) - q_yzx * v);  // t in lanes z, x, y
+    const f4 t = yzx(t_zxy);
+    const f4 u_cross_t = yzx(q * zxy(t_zxy) - q_yzx * t);  // zxy(t_zxy) is yzx(t)
+    return (v + splat(q, 3) * t) + u_cross_t;
 }
 
 }  // namespace
@@ -110,20 +128,27 @@ void local_to_model_vector(std::span<const int> parents, const LocalPoseInput& i
     quat* const model_rotations = output.rotations.data();
     vec3* const model_positions = output.positions.data();
     const size_t n = parents.size();
+    // The previous joint's result stays in registers: in a chain (most joints'
+    // parent is the joint just before) the child needs no store-to-load round trip.
+    f4 previous_rotation{};
+    f4 previous_position{};
     for (size_t i = 0; i < n; ++i) {
         const int p = parent_of[i];
         const f4 local_rotation = load_quat(local_rotations[i]);
         const f4 local_translation = load_vec3(local_translations[i]);
         if (p == kNoParent) {
-            store_quat(model_rotations[i], local_rotation);
-            store_vec3(model_positions[i], local_translation);
+            previous_rotation = local_rotation;
+            previous_position = local_translation;
         } else {
             const size_t parent = static_cast<size_t>(p);
-            const f4 parent_rotation = load_quat(model_rotations[parent]);
-            store_quat(model_rotations[i], mul(parent_rotation, local_rotation));
-            store_vec3(model_positions[i],
-                       load_vec3(model_positions[parent]) + rotate(parent_rotation, local_translation));
+            const bool previous = parent + 1 == i;
+            const f4 parent_rotation = previous ? previous_rotation : load_quat(model_rotations[parent]);
+            const f4 parent_position = previous ? previous_position : load_vec3(model_positions[parent]);
+            previous_rotation = mul(parent_rotation, local_rotation);
+            previous_position = parent_position + rotate(parent_rotation, local_translation);
         }
+        store_quat(model_rotations[i], previous_rotation);
+        store_vec3(model_positions[i], previous_position);
     }
 }
 

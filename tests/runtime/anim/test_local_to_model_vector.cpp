@@ -171,3 +171,16 @@ TEST_CASE("LocalToModelJob::run gives the scalar reference's bits", "[skeleton][
         REQUIRE(std::memcmp(sp.data(), jp.data(), n * sizeof(vec3)) == 0);
     }
 }
+
+TEST_CASE("parents_in_topological_order: the one-comparison form at the int extremes", "[skeleton][job]") {
+    const int lo = std::numeric_limits<int>::min();
+    const int hi = std::numeric_limits<int>::max();
+    CHECK(parents_in_topological_order(std::vector<int>{}));
+    CHECK(parents_in_topological_order(std::vector<int>{kNoParent, 0, 1, kNoParent, 0, 4}));
+    CHECK_FALSE(parents_in_topological_order(std::vector<int>{0}));
+    CHECK_FALSE(parents_in_topological_order(std::vector<int>{kNoParent, lo}));
+    CHECK_FALSE(parents_in_topological_order(std::vector<int>{kNoParent, hi}));
+    CHECK_FALSE(parents_in_topological_order(std::vector<int>{kNoParent, -2}));
+    CHECK_FALSE(parents_in_topological_order(std::vector<int>{kNoParent, 0, 2}));
+    CHECK_FALSE(parents_in_topological_order(std::vector<int>{kNoParent, 0, 1, 1, 5}));
+}
