@@ -55,10 +55,15 @@ struct PoseSpans {
 
 // True when every parent index is kNoParent or an earlier joint: the order
 // one forward pass needs.
+// One unsigned comparison per joint (every job's validate() runs it): with
+// kNoParent = -1, p + 1 wraps -1 to 0 and any other negative p to a huge
+// value, so p + 1 <= i exactly when p is kNoParent or in [0, i).
 inline bool parents_in_topological_order(std::span<const int> parents) {
+    static_assert(kNoParent == -1);
+    bool ok = true;
     for (std::size_t i = 0; i < parents.size(); ++i)
-        if (parents[i] != kNoParent && (parents[i] < 0 || static_cast<std::size_t>(parents[i]) >= i)) return false;
-    return true;
+        ok &= static_cast<std::size_t>(static_cast<unsigned>(parents[i]) + 1u) <= i;
+    return ok;
 }
 
 // For callers that built a job's inputs themselves (spans sized from the same

@@ -1,5 +1,7 @@
 #include "runtime/anim/skeleton.hpp"
 
+#include "runtime/anim/local_to_model.hpp"
+
 #include <map>
 
 namespace marionette {
@@ -46,19 +48,7 @@ bool LocalToModelJob::validate() const {
 
 bool LocalToModelJob::run() const {
     if (!validate()) return false;
-    const size_t n = parents.size();
-    for (size_t i = 0; i < n; ++i) {
-        const int p = parents[i];
-        if (p == kNoParent) {
-            output.rotations[i] = input.rotations[i];
-            output.positions[i] = input.translations[i];
-        } else {
-            const quat parent_rotation = output.rotations[static_cast<size_t>(p)];
-            output.rotations[i] = quat_mul(parent_rotation, input.rotations[i]);
-            output.positions[i] =
-                output.positions[static_cast<size_t>(p)] + quat_rotate(parent_rotation, input.translations[i]);
-        }
-    }
+    fk::local_to_model_vector(parents, input, output);
     return true;
 }
 
