@@ -26,6 +26,7 @@
 #include "runtime/gait/puppet.hpp"
 #include "tests/alloc_counter.hpp"
 #include "tests/test_support.hpp"
+#include "tests/render/ui_pad_driver.hpp"
 
 using namespace marionette;
 
@@ -351,17 +352,8 @@ TEST_CASE("golden image: the spline editor open over the walking puppet", "[rend
     view.set_layer(&tuning);
     render::DebugOverlay overlay{};
     render::feet_overlay_from_state(r.states[0], r.terrain, r.ankle_height, overlay);
-    std::uint32_t held = 0;
-    std::uint64_t tick = 0;
-    auto frame_with = [&](std::uint32_t buttons) {
-        const std::uint32_t event = ui::press_event(held, buttons);
-        held = buttons;
-        TickInput pad;
-        pad.buttons = buttons;
-        ++tick;
-        tuning.feed_pad(pad, tick, 8'333'333, ui::PadPress{event, tick}, true);
-        view.frame(r.states[0], overlay, "", 1.0f / 60.0f);
-    };
+    test::UiPadDriver pad_driver(tuning, view, r.states[0], overlay);
+    auto frame_with = [&](std::uint32_t buttons) { pad_driver.frame(buttons); };
     frame_with(0);
     frame_with(ui::kUiChord);
     for (int i = 0; i < 4; ++i) frame_with(0);
@@ -380,22 +372,11 @@ TEST_CASE("the pad chord opens and closes the tuning UI, the d-pad and south mov
     render::View view(ui_platform(), render::RenderSettings{}, r.skeleton, r.terrain);
     ui::TuningUi tuning(view.platform(), ui::TuningUiOptions{default_config(), "", "", stderr});
     view.set_layer(&tuning);
-    std::uint32_t held = 0;
-    std::uint64_t tick = 0;
+    const render::DebugOverlay no_overlay{};
     // One frame per tick of pad input, as the render thread would see them.
-    auto frame_with = [&](std::uint32_t buttons) {
-        const std::uint32_t event = ui::press_event(held, buttons);
-        held = buttons;
-        TickInput pad;
-        pad.buttons = buttons;
-        ++tick;
-        tuning.feed_pad(pad, tick, 8'333'333, ui::PadPress{event, tick}, true);
-        view.frame(r.states[0], render::DebugOverlay{}, "", 1.0f / 60.0f);
-    };
-    auto press = [&](Button b) {
-        frame_with(button_bit(b));
-        frame_with(0);
-    };
+    test::UiPadDriver pad_driver(tuning, view, r.states[0], no_overlay);
+    auto frame_with = [&](std::uint32_t buttons) { pad_driver.frame(buttons); };
+    auto press = [&](Button b) { pad_driver.press(b); };
     frame_with(0);
     CHECK_FALSE(tuning.is_open());
     frame_with(button_bit(Button::back));  // back alone is not the chord

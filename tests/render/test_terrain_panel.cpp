@@ -16,6 +16,7 @@
 #include "render_es/view.hpp"
 #include "runtime/gait/puppet.hpp"
 #include "runtime/sim/simulation.hpp"
+#include "tests/render/ui_pad_driver.hpp"
 
 using namespace marionette;
 using A = ui::TerrainAction;
@@ -128,21 +129,11 @@ TEST_CASE("west takes the pad to the terrain editor, south adds a box, down to S
     render::View view(panel_platform(), render::RenderSettings{}, make_puppet_skeleton(base.sim), base.sim.terrain);
     ui::TuningUi tuning(view.platform(), ui::TuningUiOptions{base, "", "terrain_west_tuned.toml", stderr});
     view.set_layer(&tuning);
-    std::uint32_t held = 0;
-    std::uint64_t tick = 0;
-    auto frame_with = [&](std::uint32_t buttons) {
-        const std::uint32_t event = ui::press_event(held, buttons);
-        held = buttons;
-        TickInput pad;
-        pad.buttons = buttons;
-        ++tick;
-        tuning.feed_pad(pad, tick, 8'333'333, ui::PadPress{event, tick}, true);
-        view.frame(PuppetState{}, render::DebugOverlay{}, "", 1.0f / 60.0f);
-    };
-    auto press = [&](Button b) {
-        frame_with(button_bit(b));
-        frame_with(0);
-    };
+    const PuppetState idle_state{};
+    const render::DebugOverlay no_overlay{};
+    test::UiPadDriver pad_driver(tuning, view, idle_state, no_overlay);
+    auto frame_with = [&](std::uint32_t buttons) { pad_driver.frame(buttons); };
+    auto press = [&](Button b) { pad_driver.press(b); };
     frame_with(0);
     frame_with(ui::kUiChord);
     REQUIRE(tuning.is_open());
