@@ -68,7 +68,11 @@ inline void store_quat(quat& q, f4 v) { std::memcpy(static_cast<void*>(&q), &v, 
 // from the store buffer (a 16-byte load over an 8- and a 4-byte store cannot).
 inline f4 load_vec3(const vec3& v) {
 #if defined(__SSE2__)
-    const __m128 xy = _mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(&v.x)));
+    // x and y as one 64-bit value through memcpy: a vec3 is only 4-byte aligned,
+    // so dereferencing it as a double would be undefined (UBSan: misaligned load).
+    double xy_bits;
+    std::memcpy(&xy_bits, &v.x, sizeof xy_bits);
+    const __m128 xy = _mm_castpd_ps(_mm_set_sd(xy_bits));
     return f4(_mm_movelh_ps(xy, _mm_load_ss(&v.z)));
 #else
     const float* f = &v.x;
@@ -78,7 +82,8 @@ inline f4 load_vec3(const vec3& v) {
 
 inline void store_vec3(vec3& v, f4 r) {
 #if defined(__SSE2__)
-    _mm_store_sd(reinterpret_cast<double*>(&v.x), _mm_castps_pd(__m128(r)));
+    const double xy_bits = _mm_cvtsd_f64(_mm_castps_pd(__m128(r)));
+    std::memcpy(&v.x, &xy_bits, sizeof xy_bits);
     _mm_store_ss(&v.z, _mm_movehl_ps(__m128(r), __m128(r)));
 #else
     float* f = &v.x;
