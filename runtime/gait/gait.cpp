@@ -523,37 +523,6 @@ PathPrediction predict_path(const GaitState& g, const GaitTick& t, vec3 root, fl
     return out;
 }
 
-// Stairs: a swing whose straight path from its lift-off spot crosses more than
-// kMaxTreadEdgesPerSwing tread edges (a run down off a landing spanned three
-// treads, 0.9 m and 72 cm down, the trailing foot left at hip height) lands
-// instead with its sole centred on the tread after the last edge it may cross:
-// one foot per tread at most two treads a swing. Ground that changes height by
-// less than kTreadEdgeM between samples kTreadSampleM apart (slopes,
-// heightfields, low rubble) has no edges and keeps its spot.
-constexpr float kTreadEdgeM = 0.08f;
-constexpr float kTreadSampleM = 0.01f;
-constexpr int kMaxTreadEdgesPerSwing = 2;
-
-vec3 fit_to_treads(const Terrain& terrain, const GaitRig& rig, vec3 from, vec3 spot) {
-    const vec3 d(spot.x - from.x, 0.0f, spot.z - from.z);
-    const float len = length3(d);
-    if (!(len > 2.0f * kTreadSampleM)) return spot;
-    const int n = static_cast<int>(len / kTreadSampleM);
-    std::array<float, kMaxTreadEdgesPerSwing + 1> edge_at{};
-    int edges = 0;
-    float prev = query_ground(terrain, from.x, from.z).height;
-    for (int k = 1; k <= n && edges <= kMaxTreadEdgesPerSwing; ++k) {
-        const float s = len * static_cast<float>(k) / static_cast<float>(n);
-        const float h = query_ground(terrain, from.x + d.x * (s / len), from.z + d.z * (s / len)).height;
-        if (std::fabs(h - prev) > kTreadEdgeM) edge_at[static_cast<std::size_t>(edges++)] = s;
-        prev = h;
-    }
-    if (edges <= kMaxTreadEdgesPerSwing) return spot;
-    const float mid = 0.5f * (edge_at[kMaxTreadEdgesPerSwing - 1] + edge_at[kMaxTreadEdgesPerSwing]);
-    const float s = maxf(edge_at[kMaxTreadEdgesPerSwing - 1], mid - 0.5f * (rig.foot_length + rig.toe_length));
-    return vec3(from.x + d.x * (s / len), 0.0f, from.z + d.z * (s / len));
-}
-
 // Where a swing starting now should land: under its hip at the middle of its
 // coming stance on the predicted path (the first step from standstill half as
 // far ahead of the root at landing), facing the heading then, on a flat spot of
@@ -564,8 +533,7 @@ Placement plan_target(const GaitState& g, const GaitTick& t, int foot, vec3 root
     const HeadingFrame then = heading_frame(p.mid_stance.heading);
     vec3 under(p.mid_stance.x, 0.0f, p.mid_stance.z);
     if (g.first_step) under = 0.5f * (under + vec3(p.landing.x, 0.0f, p.landing.z));
-    const vec3 spot = fit_to_treads(t.terrain, t.rig, g.feet[static_cast<std::size_t>(foot)].ankle,
-                                    under + then.left * (side_sign(foot) * t.rig.hip_half_width));
+    const vec3 spot = under + then.left * (side_sign(foot) * t.rig.hip_half_width);
     // The foot turns at most kMaxTurnPerStepDeg in one swing, and no faster than
     // kMaxFootTurnDegS on average (a sharp turn takes more steps to face round).
     const vec3 toes = quat_rotate(g.feet[static_cast<std::size_t>(foot)].rotation, vec3(0.0f, 0.0f, 1.0f));
