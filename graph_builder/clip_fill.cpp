@@ -185,12 +185,12 @@ Outcome check_fill_skeleton(const Skeleton& a, const Skeleton& b) {
         if (a.joint_names[u] != b.joint_names[u] || a.parents[u] != b.parents[u])
             return Outcome::failure("its skeleton differs from the input's at joint " + std::to_string(j) + " ('" +
                                     b.joint_names[u] + "' where the input has '" + a.joint_names[u] +
-                                    "'): until retargeting exists, database clips must share the input's skeleton");
+                                    "')");
     }
     if (a.joint_count() != b.joint_count())
         return Outcome::failure("its skeleton has " + std::to_string(b.joint_count()) + " joints where the input has " +
                                 std::to_string(a.joint_count()) +
-                                ": until retargeting exists, database clips must share the input's skeleton");
+                                "");
     return Outcome::success();
 }
 

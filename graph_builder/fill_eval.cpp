@@ -90,11 +90,14 @@ void measure(const Clip& filled, const std::vector<vec3>& truth, const FillGap& 
 double centimetres_per_unit(const Clip& clip) { return clip.length_unit != 1.0 ? 2.54 / clip.length_unit : 1.0; }
 
 FillEvalResult evaluate_fill(const std::vector<Clip>& clips, const std::vector<std::string>& names,
-                             const FillEvalOptions& o) {
+                             const FillEvalOptions& o, const std::vector<Clip>& extra) {
     if (clips.size() < 2) throw ImportError("--clips", 0, "leave-one-out needs at least two clips");
     for (size_t c = 1; c < clips.size(); ++c)
         if (const Outcome same = check_fill_skeleton(clips[0].skeleton, clips[c].skeleton); !same.ok())
             throw ImportError(c < names.size() ? names[c] : clips[c].name, 0, same.problem());
+    for (const Clip& e : extra)
+        if (const Outcome same = check_fill_skeleton(clips[0].skeleton, e.skeleton); !same.ok())
+            throw ImportError(e.name, 0, same.problem());
     const std::vector<bool> hidden = resolve_hidden_joints(clips[0].skeleton, o.hide, "--hide");
     const std::vector<size_t> points = moving_points(clips[0].skeleton, hidden);
     const FillMethod methods[] = {FillMethod::graph, FillMethod::slerp, FillMethod::hold};
@@ -107,6 +110,7 @@ FillEvalResult evaluate_fill(const std::vector<Clip>& clips, const std::vector<s
         std::vector<Clip> others;
         for (size_t d = 0; d < clips.size(); ++d)
             if (d != c) others.push_back(clips[d]);
+        others.insert(others.end(), extra.begin(), extra.end());
         const FillDatabase db = prepare_fill_database(std::move(others));
         const Clip& clip = clips[c];
         const std::vector<vec3> truth = model_positions_with_end_sites(clip);

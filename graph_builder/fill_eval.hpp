@@ -50,8 +50,10 @@ struct FillEvalResult {
 double centimetres_per_unit(const Clip& clip);
 
 // Every clip must share the first one's skeleton (throws ImportError naming the
-// clip otherwise) and there must be at least two.
+// clip otherwise) and there must be at least two. `extra` clips (on that
+// skeleton too: retarget them first, `retarget_fill_clip`) join every
+// leave-one-out database and are never filled themselves.
 FillEvalResult evaluate_fill(const std::vector<Clip>& clips, const std::vector<std::string>& names,
-                             const FillEvalOptions& options);
+                             const FillEvalOptions& options, const std::vector<Clip>& extra = {});
 
 }  // namespace marionette::offline

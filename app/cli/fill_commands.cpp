@@ -11,6 +11,7 @@
 #include "app/io/json.hpp"
 #include "graph_builder/clip_fill.hpp"
 #include "graph_builder/fill_eval.hpp"
+#include "graph_builder/fill_retarget.hpp"
 #include "runtime/formats/asf_amc.hpp"
 #include "runtime/formats/bvh.hpp"
 #include "runtime/formats/file_names.hpp"
@@ -29,7 +30,7 @@ struct FillCommandOptions {
 
 struct FillEvalCommandOptions {
     std::string asf, hide, gaps = "0.25,0.5,1,2,4";
-    std::vector<std::string> clips;
+    std::vector<std::string> clips, database;
     std::uint64_t seed = 1;
     int trials = 3;
     bool json = false, per_clip = false, oracle_match = false;
@@ -78,9 +79,8 @@ FillDatabase load_fill_database(const FillCommandOptions& o, const Clip& input) 
             throw ImportError(f, 0, "has the same content as the input " + o.input +
                                         ": the clip being filled must not be in its own database (add --allow-self to allow it)");
         Clip c = load_any_clip(f, o.asf);
-        if (const Outcome same = check_fill_skeleton(input.skeleton, c.skeleton); !same.ok())
-            throw ImportError(f, 0, same.problem());
         if (c.frame_count < 2) throw ImportError(f, 0, "a database clip needs at least 2 frames");
+        if (!check_fill_skeleton(input.skeleton, c.skeleton).ok()) c = retarget_fill_clip(c, f, input, o.input);
         clips.push_back(std::move(c));
     }
     if (clips.empty()) throw ImportError("--database", 0, "no database clip given");
@@ -148,7 +148,16 @@ int clip_fill_eval_command(const FillEvalCommandOptions& o) {
         clips.push_back(load_any_clip(f, o.asf));
         names.push_back(f);
     }
-    const FillEvalResult r = evaluate_fill(clips, names, eo);
+    std::vector<Clip> extra;
+    for (const std::string& f : o.database) {
+        if (lower_extension(f) == "asf") continue;
+        if (clips.empty()) break;
+        Clip c = load_any_clip(f, o.asf);
+        if (c.frame_count < 2) throw ImportError(f, 0, "a database clip needs at least 2 frames");
+        if (!check_fill_skeleton(clips[0].skeleton, c.skeleton).ok()) c = retarget_fill_clip(c, f, clips[0], names[0]);
+        extra.push_back(std::move(c));
+    }
+    const FillEvalResult r = evaluate_fill(clips, names, eo, extra);
     std::string rows;
     for (const FillEvalRow& row : r.rows) {
         if (o.json)
@@ -174,8 +183,8 @@ int clip_fill_eval_command(const FillEvalCommandOptions& o) {
                        row.gap_s, row.cases, row.mean_cm);
     }
     if (o.json)
-        fmt::print("{{\"hide\":{},\"seed\":{},\"trials\":{},\"clips\":{},\"skipped\":{},\"cm_per_unit\":{},\"oracle_match\":{},\"rows\":[{}]{}}}\n",
-                   json::quote(o.hide), o.seed, o.trials, clips.size(), r.skipped, json::number(r.cm_per_unit),
+        fmt::print("{{\"hide\":{},\"seed\":{},\"trials\":{},\"clips\":{},\"database_extra\":{},\"skipped\":{},\"cm_per_unit\":{},\"oracle_match\":{},\"rows\":[{}]{}}}\n",
+                   json::quote(o.hide), o.seed, o.trials, clips.size(), extra.size(), r.skipped, json::number(r.cm_per_unit),
                    o.oracle_match ? "true" : "false", rows,
                    o.per_clip ? ",\"per_clip\":[" + per_clip + "]" : std::string());
     return 0;
@@ -204,6 +213,8 @@ void register_clip_fill_commands(CLI::App* clip, int& exit_code) {
     eval->add_option("--asf", e->asf, "skeleton for AMC files");
     eval->add_option("--clips", e->clips, "clips (.bvh, .amc)")->required();
     eval->add_option("--hide", e->hide, "joints or group to hide")->required();
+    eval->add_option("--database", e->database,
+                     "extra database clips in every leave-one-out database, never filled (other skeletons are retargeted)");
     eval->add_option("--gaps", e->gaps, "gap lengths in seconds, comma-separated");
     eval->add_option("--seed", e->seed, "seed of the gaps' positions (splitmix64)");
     eval->add_option("--trials", e->trials, "random gaps per clip and gap length (default 3)");
