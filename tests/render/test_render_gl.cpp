@@ -466,29 +466,7 @@ TEST_CASE("golden image: the tuning UI open over the puppet", "[render][golden][
     check_golden("tuning_ui_open_walk_stop_t600", snapshot(view));
 }
 
-TEST_CASE("golden image: the spline editor open over the walking puppet", "[render][golden][ui][spline]") {
-    const Replayed r = replay_ticks("walk_stop", {600});
-    render::View view(ui_platform(), render::RenderSettings{}, r.skeleton, r.terrain);
-    ui::TuningUi tuning(view.platform(), ui::TuningUiOptions{default_config(), "", "", stderr});
-    view.set_layer(&tuning);
-    render::DebugOverlay overlay{};
-    render::feet_overlay_from_state(r.states[0], r.terrain, r.ankle_height, overlay);
-    test::UiPadDriver pad_driver(tuning, view, r.states[0], overlay);
-    auto frame_with = [&](std::uint32_t buttons) { pad_driver.frame(buttons); };
-    frame_with(0);
-    frame_with(ui::kUiChord);
-    for (int i = 0; i < 4; ++i) frame_with(0);
-    // West twice: the terrain editor, then the spline editor's curve; south: d-pad mode, up: one step.
-    for (Button b : {Button::west, Button::west, Button::south, Button::dpad_up}) {
-        frame_with(button_bit(b));
-        for (int i = 0; i < 4; ++i) frame_with(0);
-    }
-    REQUIRE(tuning.spline_pad_mode());
-    CHECK(tuning.working().sim.walk.swing_foot.keys[1].y == 0.055f);
-    check_golden("tuning_ui_spline_editor_walk_stop_t600", snapshot(view));
-}
-
-TEST_CASE("golden image: the terrain editor open over the puppet", "[render][golden][ui][terrain]") {
+TEST_CASE("golden images: the terrain editor, then the spline editor open over the walking puppet", "[render][golden][ui][spline][terrain]") {
     const Replayed r = replay_ticks("walk_stop", {600});
     render::View view(ui_platform(), render::RenderSettings{}, r.skeleton, r.terrain);
     ui::TuningUi tuning(view.platform(), ui::TuningUiOptions{default_config(), "", "", stderr});
@@ -503,10 +481,17 @@ TEST_CASE("golden image: the terrain editor open over the puppet", "[render][gol
     // West once: the terrain editor opens with the pad on its first button, "add box".
     frame_with(button_bit(Button::west));
     for (int i = 0; i < 4; ++i) frame_with(0);
-    CHECK_FALSE(tuning.spline_pad_mode());
     AppConfig edit;
     CHECK_FALSE(tuning.take_edit(edit));  // opening the section edits nothing
     check_golden("tuning_ui_terrain_editor_walk_stop_t600", snapshot(view));
+    // West again: the spline editor's curve; south: d-pad mode, up: one step.
+    for (Button b : {Button::west, Button::south, Button::dpad_up}) {
+        frame_with(button_bit(b));
+        for (int i = 0; i < 4; ++i) frame_with(0);
+    }
+    REQUIRE(tuning.spline_pad_mode());
+    CHECK(tuning.working().sim.walk.swing_foot.keys[1].y == 0.055f);
+    check_golden("tuning_ui_spline_editor_walk_stop_t600", snapshot(view));
 }
 
 TEST_CASE("the pad chord opens and closes the tuning UI, the d-pad and south move a slider", "[render][ui]") {
