@@ -1,6 +1,9 @@
 #include "render_es/view.hpp"
 
+#include <span>
+
 #include "render_es/image.hpp"
+#include "runtime/gait/gait.hpp"
 #include "runtime/gait/puppet.hpp"
 
 namespace marionette::render {
@@ -51,7 +54,7 @@ void View::screenshot(const std::string& path) {
 }
 
 void feet_overlay_from_state(const PuppetState& state, const Terrain& terrain, float ankle_height_m,
-                             DebugOverlay& overlay) {
+                             DebugOverlay& overlay, const GaitRig* rig) {
     if (state.joint_count < kPuppetJointCount) {
         overlay.foot_count = 0;
         return;
@@ -66,6 +69,10 @@ void feet_overlay_from_state(const PuppetState& state, const Terrain& terrain, f
         foot.target = vec3(ankle.x, ground.height, ankle.z);
         foot.in_contact = ankle.y - ground.height < ankle_height_m + 0.02f;
         foot.spline_points = 0;
+        const FootState& gait_foot = state.gait.feet[static_cast<std::size_t>(f)];
+        if (rig != nullptr && gait_foot.swinging)
+            foot.spline_points = sample_swing_path(gait_foot, f, *rig, state.gait.run_blend, state.gait_root.heading,
+                                                   std::span<vec3>(foot.spline.data(), foot.spline.size()));
     }
 }
 

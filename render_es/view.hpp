@@ -64,7 +64,11 @@ private:
 // Heuristic foot markers from a state alone (for logs and sims without a gait
 // overlay): each foot's ankle projected to the ground, in contact when the ankle
 // is within `contact_height_m` of the ground's height plus the ankle height.
+// With a gait rig (the render thread's own, made from the working config), each
+// swinging foot also gets its fitted step spline: the path from lift-off to the
+// aimed landing as the tick's swing math places it (sample_swing_path,
+// runtime/gait/gait.hpp), kOverlaySplinePoints points; the gait toggle draws it.
 void feet_overlay_from_state(const PuppetState& state, const Terrain& terrain, float ankle_height_m,
-                             DebugOverlay& overlay);
+                             DebugOverlay& overlay, const GaitRig* rig = nullptr);
 
 }  // namespace marionette::render

@@ -370,6 +370,7 @@ struct RenderInputs {
     std::uint64_t stall_after_frames = 0;  // test hook: PipelineOptions::test_render_stall_ns
     std::int64_t stall_ns = 0;
     const ui::TuningUiOptions* ui = nullptr;  // the tuning UI over the display (null: none)
+    const GaitConfig* gait = nullptr;         // the start's, for the render thread's own gait rig
 };
 
 // The tuning UI, made on the render thread once the view is open (its GL
@@ -383,9 +384,11 @@ std::unique_ptr<ui::TuningUi> open_tuning_ui(render::View* view, const RenderInp
 }
 
 // Before a frame: what the writer accepted, the pad, and whether the puppet gets it.
-void feed_tuning_ui(ui::TuningUi* tuning, PipelineShared& sh, const StateFrame& pair) {
-    if (tuning == nullptr) return;
-    if (sh.accepted_configs.take()) tuning->adopt(sh.accepted_configs.front());
+// Returns whether the UI's working config changed (it adopted an accepted one).
+bool feed_tuning_ui(ui::TuningUi* tuning, PipelineShared& sh, const StateFrame& pair) {
+    if (tuning == nullptr) return false;
+    const bool adopted = sh.accepted_configs.take();
+    if (adopted) tuning->adopt(sh.accepted_configs.front());
     tuning->set_puppet_position(pair.current.root_position.x, pair.current.root_position.z);
     // One press a frame, in order: ImGui sees each go down in one frame and up
     // in the next, so a d-pad move and the south press after it stay in order
@@ -401,6 +404,7 @@ void feed_tuning_ui(ui::TuningUi* tuning, PipelineShared& sh, const StateFrame& 
     tuning->feed_pad(pair.pad, pair.current.tick, pair.tick_ns, event, sh.pad_events.peek() == nullptr);
     sh.ui_passes_sticks.store(tuning->is_open() && tuning->spline_pad_mode(), std::memory_order_relaxed);
     sh.ui_captures_input.store(tuning->is_open(), std::memory_order_relaxed);
+    return adopted;
 }
 
 // Before a frame: a terrain the simulation now walks on replaces the drawn
@@ -412,8 +416,11 @@ void take_applied_terrain(PipelineShared& sh, render::View* view, Terrain& drawn
 }
 
 // After a frame: an edit made in it goes to the writer.
-void hand_over_ui_edit(ui::TuningUi* tuning, PipelineShared& sh) {
-    if (tuning != nullptr && tuning->take_edit(sh.ui_edits.back().config)) sh.ui_edits.publish();
+// Returns whether there was one.
+bool hand_over_ui_edit(ui::TuningUi* tuning, PipelineShared& sh) {
+    if (tuning == nullptr || !tuning->take_edit(sh.ui_edits.back().config)) return false;
+    sh.ui_edits.publish();
+    return true;
 }
 
 // Each frame is stamped when presented: the page flip's vblank time on KMS, after
@@ -445,6 +452,7 @@ void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, Ren
         std::fprintf(stderr, "warning: the tuning UI is off: %s\n", e.what());
     }
     // Everything a GL frame needs, made once.
+    GaitRig rig = in.gait != nullptr ? make_gait_rig(*in.gait) : GaitRig{};
     PuppetState drawn{};
     render::DebugOverlay overlay{};
     std::array<char, 256> hud{};
@@ -471,7 +479,7 @@ void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, Ren
             if (alpha > 1.0f) render::extrapolate_state(pair.previous, pair.current, alpha - 1.0f, drawn);
             else render::interpolate_state(pair.previous, pair.current, alpha, drawn);
             take_applied_terrain(sh, view.get(), terrain);
-            render::feet_overlay_from_state(drawn, terrain, in.ankle_height, overlay);
+            render::feet_overlay_from_state(drawn, terrain, in.ankle_height, overlay, in.gait != nullptr ? &rig : nullptr);
             const PipelineCounters& c = sh.counters;
             const float speed = std::sqrt(drawn.velocity.x * drawn.velocity.x + drawn.velocity.y * drawn.velocity.y);
             // The stats overlay, formatted into fixed space (no allocation in the frame).
@@ -483,10 +491,12 @@ void render_thread(PipelineShared& sh, int frame_rate_hz, bool virtual_time, Ren
                 c.tick_time_max_ns.load(std::memory_order_relaxed) / 1e3,
                 c.input_latency_max_ns.load(std::memory_order_relaxed) / 1e6,
                 c.samples_dropped.load(std::memory_order_relaxed), c.missed_frames.load(std::memory_order_relaxed));
-            feed_tuning_ui(tuning.get(), sh, pair);
+            // The drawn step splines follow the UI's working prototypes (the
+            // render thread's own rig; the simulation's is never touched here).
+            if (feed_tuning_ui(tuning.get(), sh, pair)) rig = make_gait_rig(tuning->working().sim);
             const render::FrameResult r = view->frame(drawn, overlay, std::string_view(hud.data(), n.size),
                                                       static_cast<float>(period) / 1e9f);
-            hand_over_ui_edit(tuning.get(), sh);
+            if (hand_over_ui_edit(tuning.get(), sh)) rig = make_gait_rig(tuning->working().sim);
             if (r.events.close_requested) {
                 display.closed.store(true, std::memory_order_release);
                 break;
@@ -929,7 +939,7 @@ private:
                                   &drawn_terrain_,   o_.config.ankle_height,
                                   o_.config.tick_rate_hz, o_.interpolation,
                                   o_.test_render_stall_after_frames, o_.test_render_stall_ns,
-                                  o_.ui ? &ui_options_ : nullptr};
+                                  o_.ui ? &ui_options_ : nullptr, &o_.config};
         gfx_thread_ = std::thread(render_thread, std::ref(sh_), o_.frame_rate_hz, o_.virtual_time, inputs,
                                   std::ref(display_), std::ref(result_.frame_time), std::ref(result_.present_latency));
         while (display_.state.load(std::memory_order_acquire) == DisplayThreadState::opening)

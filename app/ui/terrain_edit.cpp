@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include "app/config/terrain_file.hpp"
 #include "app/io/files.hpp"
+#include "app/ui/toml_edit.hpp"
 
 namespace marionette::ui {
 
@@ -172,16 +172,7 @@ std::string save_terrain_file(const Terrain& terrain, const std::string& path) {
     } catch (const std::exception& e) {
         return std::string("not written, the result would not load: ") + e.what();
     }
-    const std::string temporary = path + ".tmp";
-    {
-        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-        out << text;
-        if (!out.flush()) return "cannot write " + temporary;
-    }
-    std::error_code ec;
-    std::filesystem::rename(temporary, path, ec);
-    if (ec) return "cannot replace " + path + ": " + ec.message();
-    return "";
+    return write_replacing(path, text);  // beside it, then renamed over it (toml_edit.hpp)
 }
 
 }  // namespace marionette::ui

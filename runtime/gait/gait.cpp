@@ -411,9 +411,12 @@ void begin_swing(FootState& f, const Placement& target, const Terrain& terrain, 
 // included) the foot has covered by then: the arc-length table turns that into
 // the step fraction s, so a foot stepping down a riser slows its horizontal
 // progress while it descends instead of dropping in a few ticks.
-void evaluate_swing(FootState& f, int foot, const GaitConfig& c, const GaitRig& rig, float blend, vec3 left) {
-    (void)c;
-    const float u = clampf(f.progress, 0.0f, 1.0f);
+struct SwingPoint {
+    vec3 ankle;
+    float reach;  // share of the step's horizontal distance covered
+};
+SwingPoint swing_point(const FootState& f, int foot, const GaitRig& rig, float blend, vec3 left, float progress) {
+    const float u = clampf(progress, 0.0f, 1.0f);
     const vec3 shape = blended_swing(rig, blend, u);  // (sideways, lift, share of the path)
     const float share = clampf(shape.z, 0.0f, 1.0f);
     std::array<HermiteKey, kSwingPathKeys> keys{};
@@ -424,15 +427,21 @@ void evaluate_swing(FootState& f, int foot, const GaitConfig& c, const GaitRig& 
     const vec3 on_path = sample_hermite(path, s).position;  // (0, height, travel along the step)
     const float distance = swing_travel(f, rig);
     const float reach = distance > 1e-6f ? clampf(on_path.z / distance, 0.0f, 1.0f) : s;
-    f.fraction = reach;
     // The sideways swing fades out over the straight lift-off and set-down, so
     // the foot leaves and reaches its spots straight up and down.
     const float out = clampf(minf(reach, 1.0f - reach) / kHoldRotationShare, 0.0f, 1.0f);
     vec3 p = lerp(f.start, f.target, reach) + left * (side_sign(foot) * shape.x * f.lift_scale * out);
     p.y = on_path.y;
-    f.ankle = p;
-    f.rotation = swing_rotation(f, reach);
-    f.ground = f.start_ground + (f.target_ground - f.start_ground) * reach;
+    return {p, reach};
+}
+
+void evaluate_swing(FootState& f, int foot, const GaitConfig& c, const GaitRig& rig, float blend, vec3 left) {
+    (void)c;
+    const SwingPoint at = swing_point(f, foot, rig, blend, left, f.progress);
+    f.fraction = at.reach;
+    f.ankle = at.ankle;
+    f.rotation = swing_rotation(f, at.reach);
+    f.ground = f.start_ground + (f.target_ground - f.start_ground) * at.reach;
 }
 
 void land(FootState& f, GaitState& g) {
@@ -557,6 +566,18 @@ Placement stop_target(const GaitState& g, int foot, float heading, const GaitRig
 }
 
 }  // namespace
+
+int sample_swing_path(const FootState& foot, int side, const GaitRig& rig, float run_blend, float heading,
+                      std::span<vec3> out) {
+    if (!foot.swinging || out.size() < 2) return 0;
+    const vec3 left = heading_frame(heading).left;
+    const std::size_t n = out.size();
+    for (std::size_t i = 0; i < n; ++i) {
+        const float u = static_cast<float>(i) / static_cast<float>(n - 1);
+        out[i] = swing_point(foot, side, rig, run_blend, left, u).ankle;
+    }
+    return static_cast<int>(n);
+}
 
 float stick_speed_fraction(float deflection, const GaitConfig& c) {
     if (deflection <= c.stick_deadzone) return 0.0f;

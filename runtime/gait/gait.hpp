@@ -123,6 +123,16 @@ struct GaitTickInput {
 void update_gait(GaitState& gait, vec3& root_position, float& heading, vec2& velocity, const GaitTickInput& input,
                  const GaitConfig& config, const GaitRig& rig, const Terrain& terrain);
 
+// The path a swinging foot's ankle takes from lift-off (its start) to its aimed
+// landing (its target): out.size() points at evenly spaced swing progress 0 … 1,
+// each where the tick's own swing evaluation would put the ankle then, with the
+// rig's prototypes, this run blend and the gait root's heading (the sideways
+// swing is along its left). `side`: 0 left foot, 1 right. Returns the points
+// written: 0 when the foot stands or out holds fewer than 2. The gait overlay
+// draws it (render_es/view.cpp); pure, no allocation.
+int sample_swing_path(const FootState& foot, int side, const GaitRig& rig, float run_blend, float heading,
+                      std::span<vec3> out);
+
 // The seam: the pose for a gait state. Writes local transforms for the 22-joint
 // puppet and runs forward kinematics into the model spans (sizes = joint count).
 // A job (runtime/anim/pose_spans.hpp): run() returns false, touching nothing,

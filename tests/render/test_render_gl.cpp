@@ -7,6 +7,8 @@
 // (it runs this program with MARIONETTE_UPDATE_RENDER_GOLDEN=1) and look at them.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -139,6 +141,125 @@ TEST_CASE("golden images: walk_stop mid-stride on the default terrain, circle wi
         view.frame(r.states[0], overlay, "", 1.0f / 60.0f);
         check_golden("circle_t900_overlays", snapshot(view));
     }
+}
+
+namespace {
+float distance(vec3 a, vec3 b) {
+    const vec3 d = a - b;
+    return std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+}
+
+// Every tick from `first` to `last` in steps of `stride` (a fixed sample of the run).
+std::vector<std::uint64_t> tick_range(std::uint64_t first, std::uint64_t last, std::uint64_t stride) {
+    std::vector<std::uint64_t> ticks;
+    for (std::uint64_t t = first; t <= last; t += stride) ticks.push_back(t);
+    return ticks;
+}
+
+// The largest distance between two equally long overlay splines' points.
+float largest_move(const render::FootOverlay& a, const render::FootOverlay& b) {
+    float moved = 0.0f;
+    for (int i = 0; i < std::min(a.spline_points, b.spline_points); ++i)
+        moved = std::max(moved, distance(a.spline[static_cast<std::size_t>(i)], b.spline[static_cast<std::size_t>(i)]));
+    return moved;
+}
+}  // namespace
+
+// The fitted step splines the gait overlay draws, over the envelope the gait
+// walks in: the shipped walk, circle (turning) and stairs-free run programs,
+// ticks sampled across each (every 7th / 11th tick), both feet.
+TEST_CASE("the gait overlay's step spline runs from each swinging foot's lift-off to its landing target", "[render][gait_overlay]") {
+    const GaitRig rig = make_gait_rig(default_config().sim);
+    int swinging = 0, standing = 0;
+    for (const auto& [program, ticks] : {std::pair<std::string, std::vector<std::uint64_t>>{"walk_stop", tick_range(120, 900, 7)},
+                                         {"circle", tick_range(120, 1200, 11)}}) {
+        const Replayed r = replay_ticks(program, ticks);
+        for (const PuppetState& s : r.states) {
+            render::DebugOverlay overlay, without;
+            render::feet_overlay_from_state(s, r.terrain, r.ankle_height, overlay, &rig);
+            render::feet_overlay_from_state(s, r.terrain, r.ankle_height, without);
+            REQUIRE(overlay.foot_count == 2);
+            for (int f = 0; f < 2; ++f) {
+                const FootState& foot = s.gait.feet[static_cast<std::size_t>(f)];
+                const render::FootOverlay& drawn = overlay.feet[static_cast<std::size_t>(f)];
+                INFO(program << " tick " << s.tick << " foot " << f);
+                CHECK(without.feet[static_cast<std::size_t>(f)].spline_points == 0);  // no rig, no spline
+                if (!foot.swinging) {
+                    CHECK(drawn.spline_points == 0);
+                    ++standing;
+                    continue;
+                }
+                ++swinging;
+                REQUIRE(drawn.spline_points == render::kOverlaySplinePoints);
+                CHECK(distance(drawn.spline[0], foot.start) < 1e-4f);
+                CHECK(distance(drawn.spline[render::kOverlaySplinePoints - 1], foot.target) < 2e-3f);
+                float length = 0.0f;
+                for (int i = 0; i + 1 < drawn.spline_points; ++i)
+                    length += distance(drawn.spline[static_cast<std::size_t>(i)], drawn.spline[static_cast<std::size_t>(i + 1)]);
+                // The path lifts and may swing out, never more than a metre round about.
+                CHECK(length >= distance(foot.start, foot.target) - 1e-4f);
+                CHECK(length < distance(foot.start, foot.target) + 1.0f);
+            }
+        }
+    }
+    CHECK(swinging > 40);
+    CHECK(standing > 40);
+}
+
+// A prototype key edited (as the spline editor does, on the working config the
+// render thread rebuilds its rig from): every swinging foot's drawn path moves,
+// its ends stay at lift-off and landing.
+TEST_CASE("the gait overlay's step spline follows an edited swing prototype key", "[render][gait_overlay][spline]") {
+    const Replayed r = replay_ticks("walk_stop", tick_range(300, 560, 13));
+    const SimConfig base = default_config().sim;
+    const GaitRig rig = make_gait_rig(base);
+    for (int key = 1; key + 1 < base.walk.swing_foot.count; ++key) {
+        for (float PrototypeKey::*component : {&PrototypeKey::x, &PrototypeKey::z}) {
+            SimConfig edited = base;
+            PrototypeKey& k = edited.walk.swing_foot.keys[static_cast<std::size_t>(key)];
+            k.*component += component == &PrototypeKey::x ? 0.04f : -0.08f;
+            const GaitRig edited_rig = make_gait_rig(edited);
+            int compared = 0;
+            for (const PuppetState& s : r.states) {
+                render::DebugOverlay before, after;
+                render::feet_overlay_from_state(s, r.terrain, r.ankle_height, before, &rig);
+                render::feet_overlay_from_state(s, r.terrain, r.ankle_height, after, &edited_rig);
+                for (int f = 0; f < 2; ++f) {
+                    const render::FootOverlay& a = before.feet[static_cast<std::size_t>(f)];
+                    const render::FootOverlay& b = after.feet[static_cast<std::size_t>(f)];
+                    if (a.spline_points == 0) continue;
+                    INFO("key " << key << " tick " << s.tick << " foot " << f);
+                    REQUIRE(b.spline_points == a.spline_points);
+                    CHECK(largest_move(a, b) > 2e-3f);
+                    CHECK(distance(a.spline[0], b.spline[0]) < 1e-6f);
+                    CHECK(distance(a.spline[render::kOverlaySplinePoints - 1], b.spline[render::kOverlaySplinePoints - 1]) < 2e-3f);
+                    ++compared;
+                }
+            }
+            CHECK(compared > 5);
+        }
+    }
+}
+
+TEST_CASE("golden image: the gait overlay draws the fitted step spline of the swinging foot", "[render][golden][gait_overlay]") {
+    const Replayed r = replay_ticks("walk_stop", {600});
+    const PuppetState& s = r.states[0];
+    REQUIRE((s.gait.feet[0].swinging || s.gait.feet[1].swinging));
+    render::RenderSettings settings = load_render_config("").settings;
+    settings.show_hud = false;
+    settings.show_gait = settings.show_feet = true;
+    render::View view(golden_platform(), settings, r.skeleton, r.terrain);
+    const GaitRig rig = make_gait_rig(default_config().sim);
+    render::DebugOverlay overlay;
+    render::feet_overlay_from_state(s, r.terrain, r.ankle_height, overlay, &rig);
+    view.frame(s, overlay, "", 1.0f / 60.0f);
+    const render::Image with = snapshot(view);
+    check_golden("walk_stop_t600_step_splines", with);
+    // The spline is what differs from the same frame without it.
+    render::DebugOverlay plain;
+    render::feet_overlay_from_state(s, r.terrain, r.ankle_height, plain);
+    view.frame(s, plain, "", 1.0f / 60.0f);
+    CHECK(render::compare_images(snapshot(view), with, kChannelTolerance).differing_pixels > 20);
 }
 
 TEST_CASE("golden image: steps and a ramp are shaded so each face reads", "[render][golden]") {
@@ -345,7 +466,7 @@ TEST_CASE("golden image: the tuning UI open over the puppet", "[render][golden][
     check_golden("tuning_ui_open_walk_stop_t600", snapshot(view));
 }
 
-TEST_CASE("golden image: the spline editor open over the walking puppet", "[render][golden][ui][spline]") {
+TEST_CASE("golden images: the terrain editor, then the spline editor open over the walking puppet", "[render][golden][ui][spline][terrain]") {
     const Replayed r = replay_ticks("walk_stop", {600});
     render::View view(ui_platform(), render::RenderSettings{}, r.skeleton, r.terrain);
     ui::TuningUi tuning(view.platform(), ui::TuningUiOptions{default_config(), "", "", stderr});
@@ -357,8 +478,14 @@ TEST_CASE("golden image: the spline editor open over the walking puppet", "[rend
     frame_with(0);
     frame_with(ui::kUiChord);
     for (int i = 0; i < 4; ++i) frame_with(0);
-    // West twice: the terrain editor, then the spline editor's curve; south: d-pad mode, up: one step.
-    for (Button b : {Button::west, Button::west, Button::south, Button::dpad_up}) {
+    // West once: the terrain editor opens with the pad on its first button, "add box".
+    frame_with(button_bit(Button::west));
+    for (int i = 0; i < 4; ++i) frame_with(0);
+    AppConfig edit;
+    CHECK_FALSE(tuning.take_edit(edit));  // opening the section edits nothing
+    check_golden("tuning_ui_terrain_editor_walk_stop_t600", snapshot(view));
+    // West again: the spline editor's curve; south: d-pad mode, up: one step.
+    for (Button b : {Button::west, Button::south, Button::dpad_up}) {
         frame_with(button_bit(b));
         for (int i = 0; i < 4; ++i) frame_with(0);
     }
