@@ -111,7 +111,8 @@ struct FootPlacementJob {
     // release_s / 3) instead of a smoothstep lerp; and keep_above_ground's lift
     // is a critically damped spring toward the deepest the foot will be within
     // kLiftLookAheadS at its current velocity (rising before a riser is reached,
-    // falling smoothly after), never below the depth it is at now.
+    // falling smoothly after), never below the depth it is at now; and the
+    // two-bone IK bends the knee toward the thigh's +Z, not toward the clip's knee.
     bool smooth_feet = false;
 
     // False without a state, rig or terrain, with an invalid rig (a toe or tip
@@ -122,6 +123,7 @@ struct FootPlacementJob {
 
 private:
     void solve_leg(const FootPlacementLeg& leg, vec3 target, quat foot_world, vec3 forward) const;
+    vec3 thigh_pole(const FootPlacementLeg& leg, vec3 forward) const;
     float foot_depth(const FootPlacementLeg& leg, vec3 shift) const;
     bool lift_feet_above_ground(vec3 forward) const;
     float smooth_lift(FootPin& pin, const FootPlacementLeg& leg) const;

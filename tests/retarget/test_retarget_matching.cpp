@@ -3,8 +3,10 @@
 // load (the path `marionette graph build --asf 16.asf *.amc` takes), make the
 // graph whose labelled locomotion clips are the matching database; gait-eval
 // then drives `[motion] source = "matching"` with it over the shipped programs.
-// The targets that hold are asserted here; foot skate on fast_walk and joint
-// speed do not hold yet (docs/motion-matching.md, "CMU database").
+// The targets that hold are asserted here, and pop ratio and joint speed since
+// matching's knee pole follows the thigh (branch matching4); foot skate on
+// fast_walk and joint speed < 1500 °/s on slope/stairs do not hold yet
+// (docs/motion-matching.md, "CMU database", "Knee pole").
 #include <catch2/catch.hpp>
 
 #include <memory>
@@ -58,6 +60,9 @@ TEST_CASE("retarget: matching on the retargeted CMU clips follows the stick on f
             CHECK(m.start_latency_s <= 0.35);        // measured 0.046–0.067 s
             CHECK(m.heading_error_deg <= 10.0);      // measured ≤ 2.0° (−1 on circle: no moving hold)
             CHECK(m.penetration_mm <= 1.0);          // measured 0
+            CHECK(m.pop_ratio <= 4.0);               // measured 1.24–1.93 (3.7–21.7 with the clip's knee as pole)
+            // Target < 1500 °/s; measured 920–2,113 (4,939–40,045 with the clip's knee as pole).
+            CHECK(m.max_joint_speed_deg_s < 2500.0);
         }
     }
 }

@@ -235,3 +235,56 @@ TEST_CASE("FootPlacementJob: keep_above_ground lifts a foot whose tip is under t
     const Terrain flat;
     CHECK_FALSE((FootPlacementJob{&state, &rig, &flat, kBothFeetInContact, 0.0f, 0.15f, 10.0f, kLegParents, pose.spans(), true}.validate()));
 }
+
+// Matching (smooth_feet) bends the knee toward the thigh's +Z, not toward the
+// clip's knee off the hip–ankle midpoint: on a nearly straight clip leg that
+// offset points anywhere, and on the retargeted CMU clips it flipped between
+// ticks and swung the placed knee about the hip–ankle axis (40,000 °/s).
+// Generated cases (fixed seed) across the envelope: thigh pitched −0.5…+0.3 rad,
+// the clip's knee bent 0.002–0.02 rad about any horizontal axis, then about the
+// opposite one; the left foot's ground raised 5–15 cm so the IK must bend the
+// knee. The placed knee must stay put (≤ 3 cm apart; the clip's ankle moves
+// ≤ 1.7 cm) and in front of the leg. graph_feet (smooth_feet off) keeps the
+// clip's bend, and the same cases must show the swing there.
+TEST_CASE("FootPlacementJob: smooth_feet's knee bends toward the thigh however straight the clip's leg", "[foot_placement][job]") {
+    const FootPlacementRig rig = make_foot_placement_rig(kLegParents, kLeftAnkle, kRightAnkle);
+    std::uint32_t seed = 1414u;
+    auto next = [&] { seed = seed * 1664525u + 1013904223u; return static_cast<float>(seed >> 8) / 16777216.0f; };
+    float widest_swing_without = 0.0f;
+    for (int c = 0; c < 300; ++c) {
+        const float pitch = -0.5f + 0.8f * next(), bend = 0.002f + 0.018f * next(), phi = 6.2831853f * next();
+        Terrain ground;
+        ground.boxes.push_back({0.0f, -2.0f, 0.3f, 2.0f, 0.05f + 0.1f * next()});
+        for (const bool smooth : {true, false}) {
+            vec3 knees[2];
+            float ahead[2];
+            for (int flip = 0; flip < 2; ++flip) {
+                ClipPose pose;
+                const float angle = phi + (flip ? 3.14159265f : 0.0f);
+                pose.local_rotations[1] = quat_axis_angle(vec3(1.0f, 0.0f, 0.0f), pitch);
+                pose.local_rotations[2] = quat_axis_angle(vec3(std::cos(angle), 0.0f, std::sin(angle)), bend);
+                REQUIRE(LocalToModelJob{kLegParents, {pose.local_rotations, pose.local_translations},
+                                        {pose.model_rotations, pose.model_positions}}.run());
+                const vec3 thigh_z = quat_rotate(pose.model_rotations[1], vec3(0.0f, 0.0f, 1.0f));
+                FootPlacementState state;
+                FootPlacementJob job{&state, &rig, &ground, kBothFeetInContact, 0.0f, 0.15f, 10.0f, kLegParents, pose.spans()};
+                job.smooth_feet = smooth;
+                REQUIRE(job.run());
+                knees[flip] = pose.model_positions[2];
+                const vec3 off = pose.model_positions[2] - 0.5f * (pose.model_positions[1] + pose.model_positions[3]);
+                ahead[flip] = off.x * thigh_z.x + off.y * thigh_z.y + off.z * thigh_z.z;
+            }
+            const vec3 d = knees[0] - knees[1];
+            const float swing = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+            INFO("case " << c << " pitch " << pitch << " bend " << bend << " phi " << phi);
+            if (smooth) {
+                CHECK(swing <= 0.03f);
+                CHECK(ahead[0] > 0.0f);
+                CHECK(ahead[1] > 0.0f);
+            } else {
+                widest_swing_without = swing > widest_swing_without ? swing : widest_swing_without;
+            }
+        }
+    }
+    CHECK(widest_swing_without > 0.2f);  // the clip's own bend flips the knee to the other side
+}
