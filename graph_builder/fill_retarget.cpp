@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "retarget/directions.hpp"
 #include "retarget/humanoid.hpp"
 #include "retarget/pose_space.hpp"
 #include "runtime/anim/two_bone_ik.hpp"
@@ -15,34 +16,16 @@ namespace {
 
 using retarget::HumanoidChains;
 using retarget::kRoleCount;
+using retarget::point_of;
 using retarget::SourcePoint;
-
-vec3 point_of(const std::vector<vec3>& p, SourcePoint s) {
-    return lerp(p[static_cast<size_t>(s.a)], p[static_cast<size_t>(s.b)], s.t);
-}
-
-bool unit(vec3 v, vec3& out) {
-    const float l = std::sqrt(glm::dot(v, v));
-    if (!(l > 1e-8f)) return false;
-    out = v / l;
-    return true;
-}
+using retarget::unit;
+using retarget::yaw_from_to;
 
 // The rest facing (horizontal, perpendicular to the hips' line) of a skeleton.
 vec3 rest_facing(const std::vector<vec3>& p, const HumanoidChains& h) {
     const vec3 lateral = p[static_cast<size_t>(h.joint[retarget::role::thigh_l])] -
                          p[static_cast<size_t>(h.joint[retarget::role::thigh_r])];
     return glm::cross(vec3(lateral.x, 0.0f, lateral.z), vec3(0.0f, 1.0f, 0.0f));
-}
-
-// Rotation about +Y taking the horizontal part of `a` onto that of `b`.
-quat yaw_from_to(vec3 a, vec3 b) {
-    vec3 ua, ub;
-    if (!unit(vec3(a.x, 0.0f, a.z), ua) || !unit(vec3(b.x, 0.0f, b.z), ub)) return quat_identity();
-    const float d = glm::dot(ua, ub);
-    if (d < -0.99999f) return quat_wxyz(0.0f, 0.0f, 1.0f, 0.0f);
-    const vec3 c = glm::cross(ua, ub);
-    return quat_normalize(quat_wxyz(1.0f + d, c.x, c.y, c.z));
 }
 
 struct Transfer {

@@ -11,26 +11,13 @@
 namespace marionette::retarget {
 
 using detail::at;
-using detail::unit;
 
 namespace {
 
 const vec3 kUp(0.0f, 1.0f, 0.0f);
 
-// Rotation about +Y taking the horizontal part of `a` onto that of `b`.
-quat yaw_from_to(vec3 a, vec3 b) {
-    vec3 ua, ub;
-    if (!unit(vec3(a.x, 0.0f, a.z), ua) || !unit(vec3(b.x, 0.0f, b.z), ub)) return quat_identity();
-    const float d = glm::dot(ua, ub);
-    if (d < -0.99999f) return quat_wxyz(0.0f, 0.0f, 1.0f, 0.0f);
-    const vec3 c = glm::cross(ua, ub);
-    return quat_normalize(quat_wxyz(1.0f + d, c.x, c.y, c.z));
-}
-
-vec3 point_of(const std::vector<vec3>& p, SourcePoint s) {
-    return lerp(p[static_cast<size_t>(s.a)], p[static_cast<size_t>(s.b)], s.t);
-}
-using detail::point_of;
+using detail::point_of;  // a point of a ModelFrames frame
+using retarget::point_of;  // a point of one frame's positions (retarget/directions.hpp)
 
 // A Z-up source turned Y-up as a whole: every offset turned, every local
 // rotation conjugated, the roots' translations turned.

@@ -1,5 +1,6 @@
 #pragma once
 // Internals shared by retarget.cpp and contacts.cpp (not for other folders).
+#include "retarget/directions.hpp"
 #include "retarget/pose_space.hpp"
 #include "retarget/retarget.hpp"
 
@@ -22,13 +23,7 @@ inline std::size_t at(int frame, int joints, int j) {
     return static_cast<std::size_t>(frame) * static_cast<std::size_t>(joints) + static_cast<std::size_t>(j);
 }
 
-// `v` normalised into `out`; false (out untouched) for a (near-)zero vector.
-inline bool unit(vec3 v, vec3& out) {
-    const float l = std::sqrt(glm::dot(v, v));
-    if (!(l > 1e-8f)) return false;
-    out = v / l;
-    return true;
-}
+using retarget::unit;  // retarget/directions.hpp
 
 inline vec3 point_of(const ModelFrames& m, int f, SourcePoint s) { return lerp(m.position(f, s.a), m.position(f, s.b), s.t); }
 
