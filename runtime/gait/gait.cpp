@@ -605,16 +605,25 @@ float ground_grade_along(const Terrain& terrain, float x, float z, float heading
     return (ahead - behind) / (kGradeAheadM + kGradeBehindM);
 }
 
-float slope_speed_multiplier(const Terrain& terrain, const GaitConfig& c, float x, float z, float heading) {
-    const float grade = ground_grade_along(terrain, x, z, heading);
+namespace {
+// The slope factor of a measured grade (both public functions below use it).
+float slope_multiplier_of_grade(const GaitConfig& c, float grade) {
     if (grade == 0.0f) return 1.0f;  // level: what the formula gives, without the atan
     const double degrees = det::atan(std::fabs(static_cast<double>(grade))) * det::kRadToDeg;
     return clampf(1.0f - c.slope_speed_factor * static_cast<float>(degrees), 0.2f, 1.0f);
 }
+}  // namespace
 
+float slope_speed_multiplier(const Terrain& terrain, const GaitConfig& c, float x, float z, float heading) {
+    return slope_multiplier_of_grade(c, ground_grade_along(terrain, x, z, heading));
+}
+
+// The grade is measured once (four ground queries and a heading frame): it used
+// to be measured again inside slope_speed_multiplier, with the same result.
 float ground_speed(const Terrain& terrain, const GaitConfig& c, float stick_fraction, float x, float z, float heading) {
-    const float grade = std::fabs(ground_grade_along(terrain, x, z, heading));
-    const float wanted = c.max_speed * stick_fraction * slope_speed_multiplier(terrain, c, x, z, heading);
+    const float signed_grade = ground_grade_along(terrain, x, z, heading);
+    const float grade = std::fabs(signed_grade);
+    const float wanted = c.max_speed * stick_fraction * slope_multiplier_of_grade(c, signed_grade);
     return grade * wanted > kMaxClimbSpeed ? kMaxClimbSpeed / grade : wanted;
 }
 
