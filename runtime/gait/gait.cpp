@@ -188,21 +188,33 @@ quat swing_rotation(const FootState& f, float s) {
 // the rest two.
 constexpr std::array<int, kSwingPathKeys> kKeyGrid = {0, 1, 2, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 30, 31, 32};
 static_assert(kKeyGrid[kSwingPathKeys - 1] == kArcLengthIntervals);
-float key_fraction(int i) {
-    return static_cast<float>(kKeyGrid[static_cast<std::size_t>(i)]) / static_cast<float>(kArcLengthIntervals);
-}
+// Both key tables are computed once, at compile time, by the expressions the
+// swing path evaluated per key and per tick before (an IEEE float division or
+// subtraction gives the same bits at compile time as at run time).
+constexpr std::array<float, kSwingPathKeys> kKeyFraction = [] {
+    std::array<float, kSwingPathKeys> out{};
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = static_cast<float>(kKeyGrid[i]) / static_cast<float>(kArcLengthIntervals);
+    return out;
+}();
+float key_fraction(int i) { return kKeyFraction[static_cast<std::size_t>(i)]; }
 // How much of the step's horizontal distance key i has covered: none at the
 // first two keys and all at the last two, so the foot lifts off straight up and
 // sets down straight down (toes a few centimetres from a riser rise past its
 // top before they move toward it; a heel comes down onto its tread, not across
 // the edge behind it), evenly in between.
-float key_reach(int i) {
+constexpr float key_reach_of(int i) {
     constexpr int n = kSwingPathKeys;
     if (i <= 1) return 0.0f;
     if (i >= n - 2) return 1.0f;
     return static_cast<float>(kKeyGrid[static_cast<std::size_t>(i)] - kKeyGrid[1]) /
            static_cast<float>(kKeyGrid[static_cast<std::size_t>(n - 2)] - kKeyGrid[1]);
 }
+constexpr std::array<float, kSwingPathKeys> kKeyReach = [] {
+    std::array<float, kSwingPathKeys> out{};
+    for (int i = 0; i < kSwingPathKeys; ++i) out[static_cast<std::size_t>(i)] = key_reach_of(i);
+    return out;
+}();
+float key_reach(int i) { return kKeyReach[static_cast<std::size_t>(i)]; }
 // Fritsch–Butland tangent at key i of values v over key_fraction: the harmonic
 // mean of the neighbouring slopes, zero at a peak, a valley, a flat and both
 // ends, so each segment stays between its two keys (no overshoot, no dip).
@@ -233,9 +245,9 @@ float swing_travel(const FootState& f, const GaitRig& rig) {
 // The swing path's Hermite keys from its heights: key i at s = key_fraction(i),
 // position (0, height, key_reach(i) · travel); both coordinates have monotone
 // tangents, so the foot never moves back or overshoots a key's height.
-void swing_path_keys(const FootState& f, const GaitRig& rig, std::array<HermiteKey, kSwingPathKeys>& keys) {
+// `distance` is swing_travel(f, rig), which the callers have at hand.
+void swing_path_keys(const FootState& f, float distance, std::array<HermiteKey, kSwingPathKeys>& keys) {
     constexpr int n = kSwingPathKeys;
-    const float distance = swing_travel(f, rig);
     const auto height = [&](std::size_t k) { return f.path_height[k]; };
     const auto along = [&](std::size_t k) { return key_reach(static_cast<int>(k)) * distance; };
     for (int i = 0; i < n; ++i) {
@@ -371,7 +383,7 @@ void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, 
         }
     }
     std::array<HermiteKey, kSwingPathKeys> keys{};
-    swing_path_keys(f, rig, keys);
+    swing_path_keys(f, travel, keys);
     f.path_length = build_arc_length_table(keys);
 }
 
@@ -419,13 +431,13 @@ SwingPoint swing_point(const FootState& f, int foot, const GaitRig& rig, float b
     const float u = clampf(progress, 0.0f, 1.0f);
     const vec3 shape = blended_swing(rig, blend, u);  // (sideways, lift, share of the path)
     const float share = clampf(shape.z, 0.0f, 1.0f);
+    const float distance = swing_travel(f, rig);  // once: the keys are built from it too
     std::array<HermiteKey, kSwingPathKeys> keys{};
-    swing_path_keys(f, rig, keys);
+    swing_path_keys(f, distance, keys);
     const std::span<const HermiteKey> path(keys.data(), keys.size());
     const float total = f.path_length.total();
     const float s = total > 1e-6f ? clampf(time_at_arc_length(path, f.path_length, share * total), 0.0f, 1.0f) : share;
     const vec3 on_path = sample_hermite(path, s).position;  // (0, height, travel along the step)
-    const float distance = swing_travel(f, rig);
     const float reach = distance > 1e-6f ? clampf(on_path.z / distance, 0.0f, 1.0f) : s;
     // The sideways swing fades out over the straight lift-off and set-down, so
     // the foot leaves and reaches its spots straight up and down.
