@@ -263,7 +263,7 @@ constexpr float kSweepSampleM = 0.01f;  // m between ground samples along a sole
 // sole points pass over between two neighbouring keys, each point moving
 // straight from where it is at one key (ankle a0, rotation q0) to where it is
 // at the next: a box corner or a riser edge between two keys' samples is seen.
-float ground_between_keys(const Terrain& terrain, const GaitRig& rig, vec3 a0, quat q0, vec3 a1, quat q1) {
+float ground_between_keys(const GroundWindow& terrain, const GaitRig& rig, vec3 a0, quat q0, vec3 a1, quat q1) {
     float h = -kNoGroundM;
     for (const vec3& o : sole_offsets(rig)) {
         const vec3 p0 = quat_rotate(q0, o), p1 = quat_rotate(q1, o);
@@ -300,16 +300,22 @@ constexpr float kMaxPathGrade = 1.0f;          // rise (or fall) per metre of tr
 // ankle height and swing_clearance. Monotone tangents keep the curve between two
 // keys within their heights, so the sole clears every sampled ground between
 // them: the path rises before a step up and comes down only past a step edge.
-void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, const GaitConfig& c, float blend) {
+void build_swing_path(FootState& f, const Terrain& whole_terrain, const GaitRig& rig, const GaitConfig& c, float blend) {
     constexpr int n = kSwingPathKeys;
-    // The foot at a key turns between its rotations at the neighbouring keys.
-    std::array<quat, n> rotation{};
-    for (int i = 0; i < n; ++i) rotation[static_cast<std::size_t>(i)] = swing_rotation(f, key_reach(i));
-    const std::array<vec3, 3> sole = sole_offsets(rig);
+    // Every ground query below lies within the sole's reach (or the sideways
+    // swing) of the straight line from start to target: the boxes there are
+    // gathered once (a query elsewhere would still scan them all: same results).
     // The foot swings out sideways by the prototype's x (along the root's left
     // as it is then, which a turn changes): the ground under the ankle counts
     // within that distance along both axes of the ground.
     const float side = max_swing_side(rig) * f.lift_scale;
+    const float margin = side + rig.foot_length + rig.toe_length + rig.ankle_height + 0.05f;
+    const GroundWindow terrain = ground_window(whole_terrain, minf(f.start.x, f.target.x) - margin, minf(f.start.z, f.target.z) - margin,
+                                               maxf(f.start.x, f.target.x) + margin, maxf(f.start.z, f.target.z) + margin);
+    // The foot at a key turns between its rotations at the neighbouring keys.
+    std::array<quat, n> rotation{};
+    for (int i = 0; i < n; ++i) rotation[static_cast<std::size_t>(i)] = swing_rotation(f, key_reach(i));
+    const std::array<vec3, 3> sole = sole_offsets(rig);
     std::array<float, n> ground{};
     for (int i = 0; i < n; ++i) {
         const vec3 a = lerp(f.start, f.target, key_reach(i));
