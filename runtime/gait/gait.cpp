@@ -188,21 +188,33 @@ quat swing_rotation(const FootState& f, float s) {
 // the rest two.
 constexpr std::array<int, kSwingPathKeys> kKeyGrid = {0, 1, 2, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 30, 31, 32};
 static_assert(kKeyGrid[kSwingPathKeys - 1] == kArcLengthIntervals);
-float key_fraction(int i) {
-    return static_cast<float>(kKeyGrid[static_cast<std::size_t>(i)]) / static_cast<float>(kArcLengthIntervals);
-}
+// Both key tables are computed once, at compile time, by the expressions the
+// swing path evaluated per key and per tick before (an IEEE float division or
+// subtraction gives the same bits at compile time as at run time).
+constexpr std::array<float, kSwingPathKeys> kKeyFraction = [] {
+    std::array<float, kSwingPathKeys> out{};
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = static_cast<float>(kKeyGrid[i]) / static_cast<float>(kArcLengthIntervals);
+    return out;
+}();
+float key_fraction(int i) { return kKeyFraction[static_cast<std::size_t>(i)]; }
 // How much of the step's horizontal distance key i has covered: none at the
 // first two keys and all at the last two, so the foot lifts off straight up and
 // sets down straight down (toes a few centimetres from a riser rise past its
 // top before they move toward it; a heel comes down onto its tread, not across
 // the edge behind it), evenly in between.
-float key_reach(int i) {
+constexpr float key_reach_of(int i) {
     constexpr int n = kSwingPathKeys;
     if (i <= 1) return 0.0f;
     if (i >= n - 2) return 1.0f;
     return static_cast<float>(kKeyGrid[static_cast<std::size_t>(i)] - kKeyGrid[1]) /
            static_cast<float>(kKeyGrid[static_cast<std::size_t>(n - 2)] - kKeyGrid[1]);
 }
+constexpr std::array<float, kSwingPathKeys> kKeyReach = [] {
+    std::array<float, kSwingPathKeys> out{};
+    for (int i = 0; i < kSwingPathKeys; ++i) out[static_cast<std::size_t>(i)] = key_reach_of(i);
+    return out;
+}();
+float key_reach(int i) { return kKeyReach[static_cast<std::size_t>(i)]; }
 // Fritsch–Butland tangent at key i of values v over key_fraction: the harmonic
 // mean of the neighbouring slopes, zero at a peak, a valley, a flat and both
 // ends, so each segment stays between its two keys (no overshoot, no dip).
@@ -233,9 +245,9 @@ float swing_travel(const FootState& f, const GaitRig& rig) {
 // The swing path's Hermite keys from its heights: key i at s = key_fraction(i),
 // position (0, height, key_reach(i) · travel); both coordinates have monotone
 // tangents, so the foot never moves back or overshoots a key's height.
-void swing_path_keys(const FootState& f, const GaitRig& rig, std::array<HermiteKey, kSwingPathKeys>& keys) {
+// `distance` is swing_travel(f, rig), which the callers have at hand.
+void swing_path_keys(const FootState& f, float distance, std::array<HermiteKey, kSwingPathKeys>& keys) {
     constexpr int n = kSwingPathKeys;
-    const float distance = swing_travel(f, rig);
     const auto height = [&](std::size_t k) { return f.path_height[k]; };
     const auto along = [&](std::size_t k) { return key_reach(static_cast<int>(k)) * distance; };
     for (int i = 0; i < n; ++i) {
@@ -251,7 +263,7 @@ constexpr float kSweepSampleM = 0.01f;  // m between ground samples along a sole
 // sole points pass over between two neighbouring keys, each point moving
 // straight from where it is at one key (ankle a0, rotation q0) to where it is
 // at the next: a box corner or a riser edge between two keys' samples is seen.
-float ground_between_keys(const Terrain& terrain, const GaitRig& rig, vec3 a0, quat q0, vec3 a1, quat q1) {
+float ground_between_keys(const GroundWindow& terrain, const GaitRig& rig, vec3 a0, quat q0, vec3 a1, quat q1) {
     float h = -kNoGroundM;
     for (const vec3& o : sole_offsets(rig)) {
         const vec3 p0 = quat_rotate(q0, o), p1 = quat_rotate(q1, o);
@@ -288,16 +300,22 @@ constexpr float kMaxPathGrade = 1.0f;          // rise (or fall) per metre of tr
 // ankle height and swing_clearance. Monotone tangents keep the curve between two
 // keys within their heights, so the sole clears every sampled ground between
 // them: the path rises before a step up and comes down only past a step edge.
-void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, const GaitConfig& c, float blend) {
+void build_swing_path(FootState& f, const Terrain& whole_terrain, const GaitRig& rig, const GaitConfig& c, float blend) {
     constexpr int n = kSwingPathKeys;
-    // The foot at a key turns between its rotations at the neighbouring keys.
-    std::array<quat, n> rotation{};
-    for (int i = 0; i < n; ++i) rotation[static_cast<std::size_t>(i)] = swing_rotation(f, key_reach(i));
-    const std::array<vec3, 3> sole = sole_offsets(rig);
+    // Every ground query below lies within the sole's reach (or the sideways
+    // swing) of the straight line from start to target: the boxes there are
+    // gathered once (a query elsewhere would still scan them all: same results).
     // The foot swings out sideways by the prototype's x (along the root's left
     // as it is then, which a turn changes): the ground under the ankle counts
     // within that distance along both axes of the ground.
     const float side = max_swing_side(rig) * f.lift_scale;
+    const float margin = side + rig.foot_length + rig.toe_length + rig.ankle_height + 0.05f;
+    const GroundWindow terrain = ground_window(whole_terrain, minf(f.start.x, f.target.x) - margin, minf(f.start.z, f.target.z) - margin,
+                                               maxf(f.start.x, f.target.x) + margin, maxf(f.start.z, f.target.z) + margin);
+    // The foot at a key turns between its rotations at the neighbouring keys.
+    std::array<quat, n> rotation{};
+    for (int i = 0; i < n; ++i) rotation[static_cast<std::size_t>(i)] = swing_rotation(f, key_reach(i));
+    const std::array<vec3, 3> sole = sole_offsets(rig);
     std::array<float, n> ground{};
     for (int i = 0; i < n; ++i) {
         const vec3 a = lerp(f.start, f.target, key_reach(i));
@@ -371,7 +389,7 @@ void build_swing_path(FootState& f, const Terrain& terrain, const GaitRig& rig, 
         }
     }
     std::array<HermiteKey, kSwingPathKeys> keys{};
-    swing_path_keys(f, rig, keys);
+    swing_path_keys(f, travel, keys);
     f.path_length = build_arc_length_table(keys);
 }
 
@@ -419,13 +437,13 @@ SwingPoint swing_point(const FootState& f, int foot, const GaitRig& rig, float b
     const float u = clampf(progress, 0.0f, 1.0f);
     const vec3 shape = blended_swing(rig, blend, u);  // (sideways, lift, share of the path)
     const float share = clampf(shape.z, 0.0f, 1.0f);
+    const float distance = swing_travel(f, rig);  // once: the keys are built from it too
     std::array<HermiteKey, kSwingPathKeys> keys{};
-    swing_path_keys(f, rig, keys);
+    swing_path_keys(f, distance, keys);
     const std::span<const HermiteKey> path(keys.data(), keys.size());
     const float total = f.path_length.total();
     const float s = total > 1e-6f ? clampf(time_at_arc_length(path, f.path_length, share * total), 0.0f, 1.0f) : share;
     const vec3 on_path = sample_hermite(path, s).position;  // (0, height, travel along the step)
-    const float distance = swing_travel(f, rig);
     const float reach = distance > 1e-6f ? clampf(on_path.z / distance, 0.0f, 1.0f) : s;
     // The sideways swing fades out over the straight lift-off and set-down, so
     // the foot leaves and reaches its spots straight up and down.
@@ -605,16 +623,25 @@ float ground_grade_along(const Terrain& terrain, float x, float z, float heading
     return (ahead - behind) / (kGradeAheadM + kGradeBehindM);
 }
 
-float slope_speed_multiplier(const Terrain& terrain, const GaitConfig& c, float x, float z, float heading) {
-    const float grade = ground_grade_along(terrain, x, z, heading);
+namespace {
+// The slope factor of a measured grade (both public functions below use it).
+float slope_multiplier_of_grade(const GaitConfig& c, float grade) {
     if (grade == 0.0f) return 1.0f;  // level: what the formula gives, without the atan
     const double degrees = det::atan(std::fabs(static_cast<double>(grade))) * det::kRadToDeg;
     return clampf(1.0f - c.slope_speed_factor * static_cast<float>(degrees), 0.2f, 1.0f);
 }
+}  // namespace
 
+float slope_speed_multiplier(const Terrain& terrain, const GaitConfig& c, float x, float z, float heading) {
+    return slope_multiplier_of_grade(c, ground_grade_along(terrain, x, z, heading));
+}
+
+// The grade is measured once (four ground queries and a heading frame): it used
+// to be measured again inside slope_speed_multiplier, with the same result.
 float ground_speed(const Terrain& terrain, const GaitConfig& c, float stick_fraction, float x, float z, float heading) {
-    const float grade = std::fabs(ground_grade_along(terrain, x, z, heading));
-    const float wanted = c.max_speed * stick_fraction * slope_speed_multiplier(terrain, c, x, z, heading);
+    const float signed_grade = ground_grade_along(terrain, x, z, heading);
+    const float grade = std::fabs(signed_grade);
+    const float wanted = c.max_speed * stick_fraction * slope_multiplier_of_grade(c, signed_grade);
     return grade * wanted > kMaxClimbSpeed ? kMaxClimbSpeed / grade : wanted;
 }
 

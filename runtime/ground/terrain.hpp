@@ -4,6 +4,7 @@
 // is a pure function, so the gait, the renderer and the tests all see the same
 // surface. Up is +Y; heights are metres. Loading from TOML (with file/line/key
 // errors) lives in app/, since runtime/ reads no files.
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -67,5 +68,25 @@ GroundSample query_ground(const Terrain& terrain, float x, float z);
 // Highest surface point on the straight segment (x0, z0)–(x1, z1), sampled every
 // `step` metres and at both ends: what a swing foot must clear.
 float max_height_along(const Terrain& terrain, float x0, float z0, float x1, float z1, float step);
+
+// The boxes of a terrain that overlap a rectangle, gathered once for many ground
+// queries inside it (a swing path's ~800 queries scanned every box of the
+// terrain each): query_ground and max_height_along on a window give exactly
+// what they give on its terrain, at any point. A point inside the rectangle
+// scans only the gathered boxes (every box holding such a point overlaps the
+// rectangle; the boxes keep their order, so ties resolve as before), any other
+// point, or a window that overflowed kMaxWindowBoxes, scans the whole terrain.
+// The terrain must outlive the window and stay unchanged while it is used.
+inline constexpr int kMaxWindowBoxes = 64;
+struct GroundWindow {
+    const Terrain* terrain = nullptr;
+    float min_x = 0.0f, min_z = 0.0f, max_x = 0.0f, max_z = 0.0f;
+    bool overflow = false;  // more boxes overlap than fit: every query scans the terrain
+    int count = 0;
+    std::array<std::uint32_t, kMaxWindowBoxes> boxes{};  // indices into terrain->boxes, ascending
+};
+GroundWindow ground_window(const Terrain& terrain, float min_x, float min_z, float max_x, float max_z);
+GroundSample query_ground(const GroundWindow& window, float x, float z);
+float max_height_along(const GroundWindow& window, float x0, float z0, float x1, float z1, float step);
 
 }  // namespace marionette

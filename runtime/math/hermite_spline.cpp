@@ -21,15 +21,30 @@ std::size_t segment_of(std::span<const HermiteKey> keys, float time) {
 }  // namespace
 
 namespace {
+// sample_hermite(keys, time).velocity without the position: the same branches
+// and the same arithmetic, for the arc-length integration and the Newton steps,
+// which read only the speed (half of sample_hermite's work was a position they dropped).
+vec3 hermite_velocity(std::span<const HermiteKey> keys, float time) {
+    if (keys.size() < 2 || !(time > keys.front().time) || !(time < keys.back().time)) return vec3(0.0f);
+    const std::size_t i = segment_of(keys, time);
+    const HermiteKey& a = keys[i];
+    const HermiteKey& b = keys[i + 1];
+    const float h = b.time - a.time;
+    if (!(h > 0.0f)) return vec3(0.0f);
+    const float s = (time - a.time) / h;
+    const HermiteBasis d = hermite_basis_derivative(s);
+    return (a.position * d.h00 + a.tangent * (d.h10 * h) + b.position * d.h01 + b.tangent * (d.h11 * h)) / h;
+}
+
 // Length of the curve over [t0, t1]: 3-point Gauss–Legendre on |velocity|
 // (nodes 0, ±sqrt(3/5), weights 8/9, 5/9).
 float gauss_length(std::span<const HermiteKey> keys, float t0, float t1) {
     const float node = 0.7745966692414834f;
     const float mid = 0.5f * (t0 + t1);
     const float half = 0.5f * (t1 - t0);
-    const float speed_mid = length_of(sample_hermite(keys, mid).velocity);
-    const float speed_lo = length_of(sample_hermite(keys, mid - half * node).velocity);
-    const float speed_hi = length_of(sample_hermite(keys, mid + half * node).velocity);
+    const float speed_mid = length_of(hermite_velocity(keys, mid));
+    const float speed_lo = length_of(hermite_velocity(keys, mid - half * node));
+    const float speed_hi = length_of(hermite_velocity(keys, mid + half * node));
     return half * ((8.0f / 9.0f) * speed_mid + (5.0f / 9.0f) * (speed_lo + speed_hi));
 }
 }  // namespace
@@ -103,7 +118,7 @@ float time_at_arc_length(std::span<const HermiteKey> keys, const ArcLengthTable&
         const float covered = table.length[lo] + gauss_length(keys, t_lo, t);
         if (covered < distance) a = t;
         else b = t;
-        const float speed_t = length_of(sample_hermite(keys, t).velocity);
+        const float speed_t = length_of(hermite_velocity(keys, t));
         float next = speed_t > 1e-6f ? t - (covered - distance) / speed_t : 0.5f * (a + b);
         if (!(next >= a && next <= b)) next = 0.5f * (a + b);
         t = next;

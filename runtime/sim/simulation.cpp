@@ -163,7 +163,7 @@ Simulation::Simulation(const SimConfig& config, const Terrain& terrain) : config
     rig_ = make_gait_rig(config_);
     state_.gait = initial_gait_state(config_, rig_, terrain_, vec3(0.0f), 0.0f);
     state_.gait_root.position = vec3(0.0f, state_.gait.pelvis_base, 0.0f);
-    pose_gait(gait_pose_);
+    pose_gait(gait_pose_.spans(gait_joint_count()));
     output(gait_pose_, kSourceGait, 0.0f);
 }
 
@@ -309,9 +309,8 @@ void Simulation::place_feet(const Pose& clip, float dt, Pose& out, FootPlacement
     expect_job_ran(job.run());
 }
 
-void Simulation::pose_gait(Pose& out) const {
+void Simulation::pose_gait(const PoseSpans& out) const {
     const Skeleton& puppet = idle_clip_.skeleton;
-    const size_t n = static_cast<size_t>(puppet.joint_count());
     const GaitPoseJob job{&state_.gait,
                           &rig_,
                           &config_,
@@ -319,11 +318,11 @@ void Simulation::pose_gait(Pose& out) const {
                           state_.breath_time,
                           std::span<const int>(puppet.parents),
                           std::span<const vec3>(puppet.rest_offsets),
-                          out.spans(n)};
+                          out};
     expect_job_ran(job.run());
 }
 
-void Simulation::step_gait(const TickInput& input, float dt, Pose& out) {
+void Simulation::step_gait(const TickInput& input, float dt, const PoseSpans& out) {
     const SimConfig& c = config_;
     PuppetState& s = state_;
     // The gait plans (stick → velocity, steps, pelvis); the pose comes from its state.
@@ -364,6 +363,12 @@ void Simulation::output(const Pose& pose, std::int32_t source, float dt) {
         s.model_rotations[j] = pose.model_rotations[j];
         s.model_positions[j] = pose.model_positions[j];
     }
+    place_root(pose, source, dt);
+}
+
+// The root and facing of the output (for the gait, its own root: the pose is not read).
+void Simulation::place_root(const Pose& pose, std::int32_t source, float dt) {
+    PuppetState& s = state_;
     if (source == kSourceGait) {
         s.root_position = s.gait_root.position;
         s.velocity = s.gait_root.velocity;
@@ -468,7 +473,20 @@ void Simulation::step(const TickInput& input) {
     const std::int32_t from = fading ? s.fade.from : to;
     // Every source in play advances (a fading one too, so its pose keeps moving).
     auto uses = [&](std::int32_t a, std::int32_t b) { return to == a || from == a || to == b || from == b; };
-    if (uses(kSourceGait, kSourceGait)) step_gait(input, dt, gait_pose_);
+    // The gait alone, not fading: its pose is written straight into the state
+    // (the same bits output() would copy there from gait_pose_, which nothing
+    // else reads this tick; a copy of four joint arrays saved per tick).
+    const size_t gait_joints = gait_joint_count();
+    const bool gait_only = !fading && to == kSourceGait && static_cast<size_t>(s.joint_count) == gait_joints;
+    if (gait_only) {
+        const PoseSpans direct{{s.local_rotations.data(), gait_joints}, {s.local_translations.data(), gait_joints},
+                               {s.model_rotations.data(), gait_joints}, {s.model_positions.data(), gait_joints}};
+        step_gait(input, dt, direct);
+        place_root(gait_pose_, kSourceGait, dt);
+        ++s.tick;
+        return;
+    }
+    if (uses(kSourceGait, kSourceGait)) step_gait(input, dt, gait_pose_.spans(gait_joints));
     if (uses(kSourceGraph, kSourceGraphFeet)) step_graph(input, dt, graph_pose_);
     if (uses(kSourceGraphFeet, kSourceGraphFeet)) place_feet(graph_pose_, dt, feet_pose_, s.feet, s.graph.contacts);
     if (uses(kSourceMatching, kSourceMatching)) {

@@ -135,8 +135,9 @@ private:
                     {model_rotations.data(), joints}, {model_positions.data(), joints}};
         }
     };
-    void step_gait(const TickInput& input, float dt, Pose& out);
-    void pose_gait(Pose& out) const;
+    void step_gait(const TickInput& input, float dt, const PoseSpans& out);
+    void pose_gait(const PoseSpans& out) const;
+    size_t gait_joint_count() const { return static_cast<size_t>(idle_clip_.skeleton.joint_count()); }
     void step_graph(const TickInput& input, float dt, Pose& out);
     // keep_above_ground: matching's feet (FootPlacementJob::keep_above_ground); graph_feet's are placed as before.
     void place_feet(const Pose& clip, float dt, Pose& out, FootPlacementState& feet, std::uint8_t contacts,
@@ -146,6 +147,7 @@ private:
     void begin_source_change(std::int32_t source);
     float graph_heading(quat root_rotation) const;
     void output(const Pose& pose, std::int32_t source, float dt);
+    void place_root(const Pose& pose, std::int32_t source, float dt);
     void output_blend(const Pose& from, const Pose& to, float weight, float dt);
 
     SimConfig config_;

@@ -1,5 +1,8 @@
 #include <catch2/catch.hpp>
 
+#include <cmath>
+#include <limits>
+
 #include "runtime/ground/terrain.hpp"
 
 using namespace marionette;
@@ -34,6 +37,18 @@ TEST_CASE("heightfield interpolates bilinearly and clamps outside", "[terrain]")
     // h = x + 2z: normal ∝ (-1, 1, -2).
     CHECK(g.normal.x == Approx(-1.0f / std::sqrt(6.0f)));
     CHECK(g.normal.z == Approx(-2.0f / std::sqrt(6.0f)));
+}
+
+// Found by the ground window's generated cases (case 3): a NaN coordinate on a
+// heightfield terrain converted NaN to an int and read outside the heights.
+TEST_CASE("a NaN point on a heightfield reads the grid's edge, never outside it", "[terrain]") {
+    Terrain t;
+    t.heightfield = {0.0f, 0.0f, 1.0f, 2, 2, {0.0f, 1.0f, 2.0f, 3.0f}};
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    CHECK(query_ground(t, nan, 0.0f).height == 0.0f);
+    CHECK(query_ground(t, 1.0f, nan).height == 1.0f);
+    CHECK(query_ground(t, nan, nan).normal.y == 1.0f);
+    CHECK(max_height_along(t, nan, 0.0f, 1.0f, 1.0f, 0.1f) == 3.0f);
 }
 
 TEST_CASE("max_height_along finds a step between the ends", "[terrain]") {
