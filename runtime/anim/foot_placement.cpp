@@ -190,6 +190,21 @@ vec3 FootPlacementJob::pin_target(FootPin& pin, vec3 free, vec3 clip_velocity, b
     return free + pin.release_offset;
 }
 
+// smooth_feet's tilt normal: a critically damped spring (kTiltHalflifeS) per
+// component toward the ground's normal under the foot, renormalised; it starts
+// on that normal. The ground's normal jumps at a slope's edge; this does not.
+vec3 FootPlacementJob::tilt_normal(FootPin& pin, vec3 ground_normal) const {
+    if (!state->started) {
+        pin.tilt_normal = ground_normal;
+        pin.tilt_normal_velocity = vec3(0.0f);
+    } else if (dt > 0.0f) {
+        damp_toward(pin.tilt_normal.x, pin.tilt_normal_velocity.x, ground_normal.x, kTiltHalflifeS, dt);
+        damp_toward(pin.tilt_normal.y, pin.tilt_normal_velocity.y, ground_normal.y, kTiltHalflifeS, dt);
+        damp_toward(pin.tilt_normal.z, pin.tilt_normal_velocity.z, ground_normal.z, kTiltHalflifeS, dt);
+    }
+    return unit_or(pin.tilt_normal, ground_normal);
+}
+
 bool FootPlacementJob::validate() const {
     const size_t n = parents.size();
     if (!state || !rig || !terrain || !rig->valid || !(dt >= 0.0f) || !(release_s >= 0.0f) || !(terrain_rate > 0.0f)) return false;
@@ -283,7 +298,8 @@ bool FootPlacementJob::run() const {
         // A planted foot lies on the ground's slope; a lifted one keeps the clip's.
         // (The normal under the target, not under the clip's foot: a pinned foot
         // must not tilt because the clip's foot slid over a slope's edge.)
-        const vec3 normal = query_ground(*terrain, target.x, target.z).normal;
+        const vec3 ground_normal = query_ground(*terrain, target.x, target.z).normal;
+        const vec3 normal = smooth_feet ? tilt_normal(pin, ground_normal) : ground_normal;
         const quat tilt = quat_slerp(quat_identity(), quat_from_to(up, normal), smoothstep(pin.plant));
         solve_leg(leg, target, quat_normalize(quat_mul(tilt, pose.model_rotations[ankle])), forward);
     }

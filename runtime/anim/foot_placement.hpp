@@ -41,6 +41,8 @@ struct FootPin {
     vec3 unlifted_previous{0.0f};// the ankle last tick before the lift: the foot's velocity for the look-ahead
     float lift = 0.0f;           // metres the foot is raised above its placement, ≥ the depth it would penetrate
     float lift_velocity = 0.0f;  // its rate (m/s)
+    vec3 tilt_normal{0.0f, 1.0f, 0.0f};  // the ground normal the foot tilts to, following the one under it (critically damped)
+    vec3 tilt_normal_velocity{0.0f};     // its rate (1/s)
 };
 
 struct FootPlacementState {
@@ -89,6 +91,12 @@ inline constexpr float kFootLookAheadM = 0.35f;
 // and the lift spring's halflife (s).
 inline constexpr float kLiftLookAheadS = 0.1f;
 inline constexpr float kLiftHalflifeS = 0.04f;
+// smooth_feet's tilt: halflife (s) of the spring that carries the normal a foot
+// tilts to toward the ground's normal under it. The terrain's normal is
+// discontinuous where a slope meets the flat (a crease): read at one point, a
+// foot crossing it while planted or easing out of the plant turned by the
+// slope's whole angle in one tick (3,665 °/s on the default slope run).
+inline constexpr float kTiltHalflifeS = 0.05f;
 
 struct FootPlacementJob {
     FootPlacementState* state = nullptr;
@@ -112,7 +120,9 @@ struct FootPlacementJob {
     // is a critically damped spring toward the deepest the foot will be within
     // kLiftLookAheadS at its current velocity (rising before a riser is reached,
     // falling smoothly after), never below the depth it is at now; and the
-    // two-bone IK bends the knee toward the thigh's +Z, not toward the clip's knee.
+    // two-bone IK bends the knee toward the thigh's +Z, not toward the clip's knee;
+    // and the ground normal a foot tilts to follows the one under it through a
+    // critically damped spring (kTiltHalflifeS), so a crease does not snap it.
     bool smooth_feet = false;
 
     // False without a state, rig or terrain, with an invalid rig (a toe or tip
@@ -128,6 +138,7 @@ private:
     bool lift_feet_above_ground(vec3 forward) const;
     float smooth_lift(FootPin& pin, const FootPlacementLeg& leg) const;
     vec3 pin_target(FootPin& pin, vec3 free, vec3 clip_velocity, bool let_go) const;
+    vec3 tilt_normal(FootPin& pin, vec3 ground_normal) const;
 };
 
 }  // namespace marionette
