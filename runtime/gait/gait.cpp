@@ -100,7 +100,6 @@ struct Placement {
     quat rotation;
     float ground;
     float misfit;  // how far the sole had to rise to clear its toes, or a riser just ahead is above it
-    float shortened = 0.0f;  // m the step was shortened to fit the treads (plan_target's fit_to_treads)
 };
 
 // A foot fits the ground when its sole, from kHeelMarginM behind the ankle to
@@ -401,7 +400,6 @@ void begin_swing(FootState& f, const Placement& target, const Terrain& terrain, 
     f.fraction = 0.0f;
     f.lift_phase = lift_phase;
     f.timed_rate = timed_rate;
-    f.fitted_rate = 0.0f;
     const float distance = horizontal_distance(f.start, f.target);
     f.lift_scale = clampf(distance / 0.3f, 0.35f, 1.0f);
     f.swinging = 1;
@@ -453,7 +451,6 @@ void land(FootState& f, GaitState& g) {
     f.swinging = 0;
     f.progress = 0.0f;
     f.timed_rate = 0.0f;
-    f.fitted_rate = 0.0f;
     f.replanned = 0;
     ++g.steps;
 }
@@ -535,38 +532,6 @@ PathPrediction predict_path(const GaitState& g, const GaitTick& t, vec3 root, fl
     return out;
 }
 
-// Stairs: a swing whose straight path from its lift-off spot crosses more than
-// kMaxTreadEdgesPerSwing tread edges (a run down off a landing spanned three
-// treads, 0.9 m and 72 cm down, the trailing foot left at hip height behind the
-// body) lands instead with its sole centred on the tread after the last edge
-// it may cross. Ground that changes height by less than kTreadEdgeM between
-// samples kTreadSampleM apart (slopes, heightfields, low rubble) has no edges
-// and keeps its spot. The shortened swing lands earlier, at its own rate
-// (begin_aimed_swing), so the cadence keeps the ground speed (branch gait6).
-constexpr float kTreadEdgeM = 0.08f;
-constexpr float kTreadSampleM = 0.01f;
-constexpr int kMaxTreadEdgesPerSwing = 2;
-
-vec3 fit_to_treads(const Terrain& terrain, const GaitRig& rig, vec3 from, vec3 spot) {
-    const vec3 d(spot.x - from.x, 0.0f, spot.z - from.z);
-    const float len = length3(d);
-    if (!(len > 2.0f * kTreadSampleM)) return spot;
-    const int n = static_cast<int>(len / kTreadSampleM);
-    std::array<float, kMaxTreadEdgesPerSwing + 1> edge_at{};
-    int edges = 0;
-    float prev = query_ground(terrain, from.x, from.z).height;
-    for (int k = 1; k <= n && edges <= kMaxTreadEdgesPerSwing; ++k) {
-        const float s = len * static_cast<float>(k) / static_cast<float>(n);
-        const float h = query_ground(terrain, from.x + d.x * (s / len), from.z + d.z * (s / len)).height;
-        if (std::fabs(h - prev) > kTreadEdgeM) edge_at[static_cast<std::size_t>(edges++)] = s;
-        prev = h;
-    }
-    if (edges <= kMaxTreadEdgesPerSwing) return spot;
-    const float mid = 0.5f * (edge_at[kMaxTreadEdgesPerSwing - 1] + edge_at[kMaxTreadEdgesPerSwing]);
-    const float s = maxf(edge_at[kMaxTreadEdgesPerSwing - 1], mid - 0.5f * (rig.foot_length + rig.toe_length));
-    return vec3(from.x + d.x * (s / len), 0.0f, from.z + d.z * (s / len));
-}
-
 // Where a swing starting now should land: under its hip at the middle of its
 // coming stance on the predicted path (the first step from standstill half as
 // far ahead of the root at landing), facing the heading then, on a flat spot of
@@ -577,17 +542,14 @@ Placement plan_target(const GaitState& g, const GaitTick& t, int foot, vec3 root
     const HeadingFrame then = heading_frame(p.mid_stance.heading);
     vec3 under(p.mid_stance.x, 0.0f, p.mid_stance.z);
     if (g.first_step) under = 0.5f * (under + vec3(p.landing.x, 0.0f, p.landing.z));
-    const vec3 planned = under + then.left * (side_sign(foot) * t.rig.hip_half_width);
-    const vec3 spot = fit_to_treads(t.terrain, t.rig, g.feet[static_cast<std::size_t>(foot)].ankle, planned);
+    const vec3 spot = under + then.left * (side_sign(foot) * t.rig.hip_half_width);
     // The foot turns at most kMaxTurnPerStepDeg in one swing, and no faster than
     // kMaxFootTurnDegS on average (a sharp turn takes more steps to face round).
     const vec3 toes = quat_rotate(g.feet[static_cast<std::size_t>(foot)].rotation, vec3(0.0f, 0.0f, 1.0f));
     const double yaw = det::atan2(toes.x, toes.z);
     const double facing = yaw + clamp_magnitude(det::wrap_angle(static_cast<double>(p.mid_stance.heading) - yaw),
                                                 max_foot_turn(p.time));
-    Placement out = place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, heading_frame(facing).forward);
-    out.shortened = horizontal_distance(planned, spot);
-    return out;
+    return place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, heading_frame(facing).forward);
 }
 
 constexpr float kShortestSwing = 0.12f;           // s: a late lift-off still swings this long
@@ -726,8 +688,6 @@ constexpr float kMinHipDropShareSq = 0.09f;        // the hip stays at least 0.3
 constexpr float kEarlyLiftPhase = 0.05f;          // … at most this much of a cycle before its duty factor
 constexpr float kEarlyLiftReachShare = 0.9f;      // a planted foot this share of the leg reach behind its hip lifts
 constexpr float kEarlyLiftStanceShare = 0.95f;    // … or this share of kStanceReachM (before the root pivots on it)
-constexpr float kMinFitSpeed = 0.3f;               // m/s: slower, a step fitted to the treads keeps the cycle's pace
-constexpr float kMinFittedSwingShare = 0.5f;       // a fitted swing takes at least this share of its planned time
 constexpr float kSinkByProgress = 0.95f;           // a swing's soft limit is met by this progress, just before touchdown
 constexpr float kNoLimitM = 1e9f;                  // m: a pelvis height limit that no foot imposes
 
@@ -902,39 +862,15 @@ float shortest_swing(const FootState& f, const GaitRig& rig) { return maxf(kShor
 // run near 1.9 m/s): aimed for the phase's time, it landed behind the root, was
 // flagged stranded and re-aimed over and over (the spun-stick test's case 27,
 // foot_l 5,358 °/s). It is aimed again for its own, longer time then.
-//
-// A step fitted to the treads (plan_target's fit_to_treads) is shorter than
-// the one planned by `shortened`: it lands that distance's worth of time at the
-// ground speed sooner, at a rate fixed at lift-off (fitted_rate), and its
-// landing brings the cycle's phase forward to its contact (land_fitted), so the
-// cadence quickens for this step only and the other foot's swing rate never
-// changes mid-swing. Without the earlier landing the shorter stride at the same
-// cadence let the planted foot hold the root back (speed error 17-95 %, gait5).
 void begin_aimed_swing(GaitState& g, const GaitTick& t, vec3 root, int i, float psi) {
     FootState& f = g.feet[static_cast<std::size_t>(i)];
     const float remaining = 1.0f - psi;
-    Placement p = aim_swing(g, t, root, i, remaining);
-    begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
+    begin_swing(f, aim_swing(g, t, root, i, remaining), t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
     if (!(t.dphase > 0.0f)) return;
     const float phase_time = maxf(kMinSwingPhaseShare, remaining) * t.dt / t.dphase;
     const float swing_time = shortest_swing(f, t.rig);
-    float time = phase_time;
-    if (swing_time > phase_time) {
-        p = aim_swing(g, t, root, i, swing_time * t.dphase / t.dt);
-        begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
-        time = swing_time;
-    }
-    if (!(p.shortened > 0.0f) || !(g.speed > kMinFitSpeed)) return;
-    const float fitted = maxf(maxf(shortest_swing(f, t.rig), kMinFittedSwingShare * time), time - p.shortened / g.speed);
-    if (fitted < time) f.fitted_rate = 1.0f / fitted;
-}
-
-// A fitted swing that landed before its foot's phase came round brings the
-// cycle's phase forward to its contact (the other foot's swing keeps its rate:
-// a phase-driven swing's progress adds up the cycle's per-tick advance, not its phase).
-void land_fitted(GaitState& g, int i, float lift_phase) {
-    const float psi = foot_phase(g.cycle_phase, i);
-    if (psi >= lift_phase) g.cycle_phase = i == 0 ? 0.0f : kRightFootPhase;
+    if (swing_time > phase_time)
+        begin_swing(f, aim_swing(g, t, root, i, swing_time * t.dphase / t.dt), t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
 }
 
 // The foot's phase for a re-aim. A swing that outlasts its phase (held to its
@@ -951,7 +887,6 @@ float swing_phase_now(const FootState& f, float cycle_phase, int i) {
 // cycle's phase (over what was left of it at lift-off), but never slower than a
 // kShortestSwing swing.
 float swing_rate(const FootState& f, const GaitTick& t) {
-    if (f.fitted_rate > 0.0f) return f.fitted_rate;
     return f.timed_rate > 0.0f ? f.timed_rate
                                : minf(t.dphase / t.dt / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), 1.0f / shortest_swing(f, t.rig));
 }
@@ -999,15 +934,12 @@ void reaim_if_command_changed(GaitState& g, const GaitTick& t, vec3 root, int i)
 // kShortestSwing swing. It lands at progress 1.
 void advance_swing(GaitState& g, const GaitTick& t, vec3 root, int i) {
     FootState& f = g.feet[static_cast<std::size_t>(i)];
-    const float rate = f.fitted_rate > 0.0f  ? f.fitted_rate * t.dt
-                       : f.timed_rate > 0.0f ? f.timed_rate * t.dt
-                                             : minf(t.dphase / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), t.dt / shortest_swing(f, t.rig));
+    const float rate = f.timed_rate > 0.0f
+                           ? f.timed_rate * t.dt
+                           : minf(t.dphase / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), t.dt / shortest_swing(f, t.rig));
     f.progress += rate;
     if (f.progress >= 1.0f) {
-        const bool fitted = f.fitted_rate > 0.0f && g.mode == GaitMode::stepping;
-        const float lift_phase = f.lift_phase;
         land(f, g);
-        if (fitted) land_fitted(g, i, lift_phase);
         g.first_step = 0;
         return;
     }

@@ -39,7 +39,6 @@ struct FootState {
     float fraction = 0.0f;                    // of the step's horizontal distance covered
     float lift_phase = 0.0f;                  // the foot's cycle phase at lift-off (progress 0)
     float timed_rate = 0.0f;                  // > 0: progress per second (stop transition), else phase-driven
-    float fitted_rate = 0.0f;                 // > 0: a step fitted to the treads, progress per second fixed at lift-off
     float lift_scale = 1.0f;                  // small steps lift less
     float reach_carry = 0.0f;                 // mid-swing reach allowance a re-aimed swing took over (docs/gait.md, Pelvis)
     std::int32_t replanned = 0;               // times this swing re-aimed (at most 3)

@@ -79,9 +79,6 @@ void hash_gait(HashBytes& h, const GaitState& g) {
         const float scalars[9] = {f.ground, f.start_ground, f.target_ground, f.progress, f.fraction, f.lift_phase, f.timed_rate, f.lift_scale,
                                   f.reach_carry};
         hash_floats(h, scalars, 9);
-        // A step fitted to the treads (docs/gait.md, branch gait6) adds its
-        // rate; states without one hash as they did before it existed.
-        if (f.fitted_rate > 0.0f) hash_floats(h, &f.fitted_rate, 1);
         hash_floats(h, f.path_height.data(), f.path_height.size());
         hash_floats(h, f.path_length.length.data(), f.path_length.length.size());
         hash_ints(h, {f.swinging, f.replanned});
