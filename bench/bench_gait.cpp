@@ -4,6 +4,7 @@
 // Run: build/release/bench/marionette_bench_gait
 #include <benchmark/benchmark.h>
 
+#include "bench_rubble.hpp"
 #include "runtime/sim/simulation.hpp"
 #include "runtime/anim/two_bone_ik.hpp"
 
@@ -33,14 +34,7 @@ BENCHMARK(BM_TwoBoneIk);
 
 void BM_GaitTick(benchmark::State& state) {
     set_simulation_float_mode();
-    Terrain terrain;
-    if (state.range(1)) {  // rubble-like: 180 boxes around the path
-        for (int i = 0; i < 180; ++i) {
-            const float x = static_cast<float>((i * 37) % 120) / 10.0f - 6.0f;
-            const float z = static_cast<float>((i * 53) % 180) / 10.0f - 14.0f;
-            terrain.boxes.push_back({x, z, x + 0.3f, z + 0.4f, 0.01f * static_cast<float>(i % 8)});
-        }
-    }
+    const Terrain terrain = state.range(1) ? bench_rubble_terrain() : Terrain{};
     Simulation sim(SimConfig{}, terrain);
     TickInput in;
     in.left_y = static_cast<std::int16_t>(state.range(0));

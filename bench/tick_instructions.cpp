@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "bench_rubble.hpp"
 #include "runtime/sim/simulation.hpp"
 
 using namespace marionette;
@@ -29,14 +30,7 @@ int main(int argc, char** argv) {
         return 2;
     }
     set_simulation_float_mode();
-    Terrain terrain;
-    if (!std::strcmp(argv[2], "rubble")) {  // BM_GaitTick's rubble
-        for (int i = 0; i < 180; ++i) {
-            const float x = static_cast<float>((i * 37) % 120) / 10.0f - 6.0f;
-            const float z = static_cast<float>((i * 53) % 180) / 10.0f - 14.0f;
-            terrain.boxes.push_back({x, z, x + 0.3f, z + 0.4f, 0.01f * static_cast<float>(i % 8)});
-        }
-    }
+    const Terrain terrain = !std::strcmp(argv[2], "rubble") ? bench_rubble_terrain() : Terrain{};
     Simulation sim(SimConfig{}, terrain);
     TickInput in;
     in.left_y = !std::strcmp(argv[1], "idle") ? 0 : (!std::strcmp(argv[1], "walk") ? 20000 : 32767);
