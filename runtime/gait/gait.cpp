@@ -388,9 +388,9 @@ void build_swing_path(FootState& f, const Terrain& whole_terrain, const GaitRig&
             f.path_height[k] = maxf(f.path_height[k], f.path_height[static_cast<std::size_t>(jj)] - kMaxPathGrade * d);
         }
     }
-    std::array<HermiteKey, kSwingPathKeys> keys{};
-    swing_path_keys(f, travel, keys);
-    f.path_length = build_arc_length_table(keys);
+    f.path_travel = travel;
+    swing_path_keys(f, travel, f.path_keys);
+    f.path_length = build_arc_length_table(f.path_keys);
 }
 
 // How much of the mid-swing reach allowance (kFullLegReachShare over the
@@ -437,10 +437,8 @@ SwingPoint swing_point(const FootState& f, int foot, const GaitRig& rig, float b
     const float u = clampf(progress, 0.0f, 1.0f);
     const vec3 shape = blended_swing(rig, blend, u);  // (sideways, lift, share of the path)
     const float share = clampf(shape.z, 0.0f, 1.0f);
-    const float distance = swing_travel(f, rig);  // once: the keys are built from it too
-    std::array<HermiteKey, kSwingPathKeys> keys{};
-    swing_path_keys(f, distance, keys);
-    const std::span<const HermiteKey> path(keys.data(), keys.size());
+    const float distance = f.path_travel;  // the keys and travel of the swing, built at its start
+    const std::span<const HermiteKey> path(f.path_keys.data(), f.path_keys.size());
     const float total = f.path_length.total();
     const float s = total > 1e-6f ? clampf(time_at_arc_length(path, f.path_length, share * total), 0.0f, 1.0f) : share;
     const vec3 on_path = sample_hermite(path, s).position;  // (0, height, travel along the step)
@@ -881,7 +879,8 @@ Placement aim_swing(const GaitState& g, const GaitTick& t, vec3 root, int i, flo
 // at kMaxMeanSwingSpeed. A foot lifting (or re-aimed) late in its phase had the
 // cycle's few remaining hundredths of a second for up to 0.9 m: its shin passed
 // 1500 °/s (wall × reversals after a long stop swing, 1506 °/s).
-float shortest_swing(const FootState& f, const GaitRig& rig) { return maxf(kShortestSwing, swing_travel(f, rig) / kMaxMeanSwingSpeed); }
+// f.path_travel is swing_travel(f, rig), computed once at the swing's start.
+float shortest_swing(const FootState& f) { return maxf(kShortestSwing, f.path_travel / kMaxMeanSwingSpeed); }
 
 // Starts (or re-aims) foot i's phase-driven swing at its phase psi, aimed for
 // the time it will take. A swing held to its travel at kMaxMeanSwingSpeed
@@ -895,7 +894,7 @@ void begin_aimed_swing(GaitState& g, const GaitTick& t, vec3 root, int i, float 
     begin_swing(f, aim_swing(g, t, root, i, remaining), t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
     if (!(t.dphase > 0.0f)) return;
     const float phase_time = maxf(kMinSwingPhaseShare, remaining) * t.dt / t.dphase;
-    const float swing_time = shortest_swing(f, t.rig);
+    const float swing_time = shortest_swing(f);
     if (swing_time > phase_time)
         begin_swing(f, aim_swing(g, t, root, i, swing_time * t.dphase / t.dt), t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
 }
@@ -915,7 +914,7 @@ float swing_phase_now(const FootState& f, float cycle_phase, int i) {
 // kShortestSwing swing.
 float swing_rate(const FootState& f, const GaitTick& t) {
     return f.timed_rate > 0.0f ? f.timed_rate
-                               : minf(t.dphase / t.dt / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), 1.0f / shortest_swing(f, t.rig));
+                               : minf(t.dphase / t.dt / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), 1.0f / shortest_swing(f));
 }
 
 // Where a swing's hip will be when it lands, if the root keeps its speed and heading.
@@ -963,7 +962,7 @@ void advance_swing(GaitState& g, const GaitTick& t, vec3 root, int i) {
     FootState& f = g.feet[static_cast<std::size_t>(i)];
     const float rate = f.timed_rate > 0.0f
                            ? f.timed_rate * t.dt
-                           : minf(t.dphase / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), t.dt / shortest_swing(f, t.rig));
+                           : minf(t.dphase / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), t.dt / shortest_swing(f));
     f.progress += rate;
     if (f.progress >= 1.0f) {
         land(f, g);
