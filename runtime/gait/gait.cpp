@@ -4,6 +4,7 @@
 
 #include "runtime/gait/puppet.hpp"
 #include "runtime/gait/steering.hpp"
+#include "runtime/anim/local_to_model.hpp"
 #include "runtime/anim/skeleton.hpp"
 #include "runtime/anim/two_bone_ik.hpp"
 
@@ -1182,14 +1183,10 @@ namespace {
 bool finite3(vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 bool positive_length(float metres) { return metres > 0.0f && std::isfinite(metres); }
 
-// Runs an IK job whose inputs GaitPoseJob::validate() vouched for (positive
-// bone lengths, a finite state), so it cannot fail.
-TwoBoneIkResult solve_limb(TwoBoneIkJob ik) {
-    TwoBoneIkResult result;
-    ik.result = &result;
-    expect_job_ran(ik.run());
-    return result;
-}
+// Solves an IK job whose inputs GaitPoseJob::validate() vouched for (positive,
+// finite bone lengths, a finite state): validated once per pose, not again per
+// limb (TwoBoneIkJob::run would repeat the check four times a tick).
+TwoBoneIkResult solve_limb(const TwoBoneIkJob& ik) { return solve_two_bone_ik(ik); }
 }  // namespace
 
 bool GaitPoseJob::validate() const {
@@ -1199,7 +1196,7 @@ bool GaitPoseJob::validate() const {
         return false;
     const GaitRig& r = *rig;
     return positive_length(r.thigh) && positive_length(r.shin) && positive_length(r.upper_arm) &&
-           positive_length(r.forearm) && std::isfinite(heading) && finite3(gait->pelvis) &&
+           positive_length(r.forearm) && std::isfinite(r.hip_half_width) && std::isfinite(heading) && finite3(gait->pelvis) &&
            finite3(gait->feet[0].ankle) && finite3(gait->feet[1].ankle);
 }
 
@@ -1243,7 +1240,9 @@ bool GaitPoseJob::run() const {
         pose.local_rotations[thigh + 1] = quat_normalize(quat_mul(quat_conjugate(s.upper_rotation), s.lower_rotation));
         pose.local_rotations[thigh + 2] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), f.rotation));
     }
-    expect_job_ran(LocalToModelJob{parents, pose.local(), pose.model()}.run());
+    // validate() checked what LocalToModelJob::validate() would (span sizes,
+    // parents in order): its kernel runs directly.
+    fk::local_to_model_vector(parents, pose.local(), pose.model());
 
     // Arms: the hands follow the blended hand paths, swinging against the legs;
     // elbows point back.

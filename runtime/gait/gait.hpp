@@ -156,7 +156,9 @@ struct GaitPoseJob {
 
     // False without a state, rig or config, with spans not of the puppet's joint
     // count, parents out of order, a bone length that is not positive, or a
-    // state the IK cannot solve (not finite).
+    // state the IK cannot solve (not finite). run() checks this once and then
+    // runs the four IK solves and forward kinematics without their own checks
+    // (it covers theirs); the rest offsets are the caller's skeleton, not checked.
     bool validate() const;
     [[nodiscard]] bool run() const;
 };
