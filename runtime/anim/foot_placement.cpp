@@ -190,19 +190,25 @@ vec3 FootPlacementJob::pin_target(FootPin& pin, vec3 free, vec3 clip_velocity, b
     return free + pin.release_offset;
 }
 
-// smooth_feet's tilt normal: a critically damped spring (kTiltHalflifeS) per
-// component toward the ground's normal under the foot, renormalised; it starts
-// on that normal. The ground's normal jumps at a slope's edge; this does not.
+vec3 step_tilt_normal(vec3& normal, vec3& velocity, vec3 ground_normal, float dt) {
+    if (dt > 0.0f) {
+        damp_toward(normal.x, velocity.x, ground_normal.x, kTiltHalflifeS, dt);
+        damp_toward(normal.y, velocity.y, ground_normal.y, kTiltHalflifeS, dt);
+        damp_toward(normal.z, velocity.z, ground_normal.z, kTiltHalflifeS, dt);
+    }
+    return unit_or(normal, ground_normal);
+}
+
+// smooth_feet's tilt normal: step_tilt_normal toward the ground's normal under
+// the foot; it starts on that normal. The ground's normal jumps at a slope's
+// edge; this does not.
 vec3 FootPlacementJob::tilt_normal(FootPin& pin, vec3 ground_normal) const {
     if (!state->started) {
         pin.tilt_normal = ground_normal;
         pin.tilt_normal_velocity = vec3(0.0f);
-    } else if (dt > 0.0f) {
-        damp_toward(pin.tilt_normal.x, pin.tilt_normal_velocity.x, ground_normal.x, kTiltHalflifeS, dt);
-        damp_toward(pin.tilt_normal.y, pin.tilt_normal_velocity.y, ground_normal.y, kTiltHalflifeS, dt);
-        damp_toward(pin.tilt_normal.z, pin.tilt_normal_velocity.z, ground_normal.z, kTiltHalflifeS, dt);
+        return unit_or(pin.tilt_normal, ground_normal);
     }
-    return unit_or(pin.tilt_normal, ground_normal);
+    return step_tilt_normal(pin.tilt_normal, pin.tilt_normal_velocity, ground_normal, dt);
 }
 
 bool FootPlacementJob::validate() const {

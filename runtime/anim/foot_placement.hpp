@@ -98,6 +98,16 @@ inline constexpr float kLiftHalflifeS = 0.04f;
 // slope's whole angle in one tick (3,665 °/s on the default slope run).
 inline constexpr float kTiltHalflifeS = 0.05f;
 
+// One tick of smooth_feet's tilt spring: `normal` (rate `velocity`, 1/s) is
+// carried toward `ground_normal` as a critically damped spring per component
+// (halflife kTiltHalflifeS; e^−x as the rational 1/(1 + x + 0.48x² + 0.235x³),
+// no libm); dt ≤ 0 leaves it. Returns `normal` renormalised (`ground_normal` if
+// it is degenerate). Its envelope: with every ground normal within an angle α
+// of some axis (α < 90°), the returned normal turns at most
+// (2y/e)·tan α rad/s, y = 2 ln 2 / kTiltHalflifeS (a single step of θ from
+// rest: α = θ/2, ~154 °/s for 15°); held, it converges to the held normal.
+vec3 step_tilt_normal(vec3& normal, vec3& velocity, vec3 ground_normal, float dt);
+
 struct FootPlacementJob {
     FootPlacementState* state = nullptr;
     const FootPlacementRig* rig = nullptr;

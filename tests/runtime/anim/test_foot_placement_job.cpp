@@ -2,8 +2,10 @@
 // the terrain over a clip pose, as a job.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <vector>
 
 #include "runtime/anim/foot_placement.hpp"
@@ -287,4 +289,147 @@ TEST_CASE("FootPlacementJob: smooth_feet's knee bends toward the thigh however s
         }
     }
     CHECK(widest_swing_without > 0.2f);  // the clip's own bend flips the knee to the other side
+}
+
+// smooth_feet's tilt spring (step_tilt_normal), generated across its envelope:
+// fixed-seed sequences of ground normals of four kinds — steps (a new normal held
+// 1–200 ticks), creases (a flat/slope pair, the foot crossing back and forth,
+// single-tick flickers included), noise (a base normal shaken every tick, as on
+// a heightfield) and slow sweeps — every normal within 60° of up, at a tick rate
+// drawn from the config's envelope (30–2000 Hz), then the last normal held 1 s.
+// The spring is linear per component with a non-negative position kernel, so the
+// normal it carries stays in the convex hull of the normals it was given, and
+// its velocity is at most (2y/e)·max|goal − c| for any c (the L1 norm of its
+// velocity kernel y²(1 − yt)e^(−yt) is 2y/e): with every goal within α of an
+// axis c, the returned unit normal turns at most (2y/e)·tan α rad/s.
+namespace {
+struct TiltCase {
+    std::vector<vec3> goals;
+    float dt = 0.0f;
+};
+
+vec3 normal_at(float tilt, float azimuth) {
+    return vec3(std::sin(tilt) * std::cos(azimuth), std::cos(tilt), std::sin(tilt) * std::sin(azimuth));
+}
+
+double angle_between(vec3 a, vec3 b) {
+    const double cx = double(a.y) * b.z - double(a.z) * b.y, cy = double(a.z) * b.x - double(a.x) * b.z,
+                 cz = double(a.x) * b.y - double(a.y) * b.x;
+    const double dot = double(a.x) * b.x + double(a.y) * b.y + double(a.z) * b.z;
+    return std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), dot);
+}
+
+TiltCase generate_tilt_case(int kind, const std::function<float()>& next) {
+    static constexpr int kRates[] = {30, 60, 120, 240, 480, 1000, 2000};
+    TiltCase c;
+    const int rate = next() < 0.5f ? kRates[static_cast<int>(next() * 6.999f)] : 30 + static_cast<int>(1970.0f * next());
+    c.dt = 1.0f / static_cast<float>(rate);
+    const int ticks = static_cast<int>((0.5f + 2.5f * next()) * static_cast<float>(rate));
+    const float max_tilt = 1.0471976f;  // 60°
+    vec3 held = normal_at(max_tilt * next(), 6.2831853f * next());
+    const vec3 other = normal_at(max_tilt * next(), 6.2831853f * next());
+    const vec3 base = held;
+    int hold = 0;
+    bool on_other = false;
+    for (int t = 0; t < ticks; ++t) {
+        if (kind == 0) {  // steps
+            if (hold-- <= 0) held = normal_at(max_tilt * next(), 6.2831853f * next()), hold = static_cast<int>(200.0f * next());
+        } else if (kind == 1) {  // a crease crossed back and forth
+            if (hold-- <= 0) on_other = !on_other, hold = next() < 0.3f ? 0 : static_cast<int>(100.0f * next());
+            held = on_other ? other : base;
+        } else if (kind == 2) {  // noise about a base normal, up to 10° every tick
+            const vec3 shaken = base + 0.18f * normal_at(1.5707963f * next(), 6.2831853f * next());
+            held = shaken / std::sqrt(shaken.x * shaken.x + shaken.y * shaken.y + shaken.z * shaken.z);
+            if (angle_between(held, vec3(0.0f, 1.0f, 0.0f)) > max_tilt) held = base;
+        } else {  // a slow sweep from base to other
+            const float u = static_cast<float>(t) / static_cast<float>(ticks);
+            const vec3 mixed = base * (1.0f - u) + other * u;
+            held = mixed / std::sqrt(mixed.x * mixed.x + mixed.y * mixed.y + mixed.z * mixed.z);
+        }
+        c.goals.push_back(held);
+    }
+    for (int t = 0; t < rate; ++t) c.goals.push_back(held);  // held 1 s: 20 halflives
+    return c;
+}
+
+// The unit normals the spring returns for a case, started at rest on the first goal.
+std::vector<vec3> run_tilt_spring(const TiltCase& c) {
+    std::vector<vec3> out;
+    vec3 normal = c.goals.front(), velocity(0.0f);
+    for (const vec3& goal : c.goals) out.push_back(step_tilt_normal(normal, velocity, goal, c.dt));
+    return out;
+}
+
+// The bound (rad/s) on the turn rate: (2y/e)·tan α, α the widest angle of a goal
+// from the better of two axes (up, the goals' mean direction).
+double tilt_turn_bound(const std::vector<vec3>& goals) {
+    vec3 sum(0.0f);
+    for (const vec3& g : goals) sum += g;
+    double alpha = 1e9;
+    for (const vec3& axis : {vec3(0.0f, 1.0f, 0.0f), sum}) {
+        double widest = 0.0;
+        for (const vec3& g : goals) widest = std::max(widest, angle_between(axis, g));
+        alpha = std::min(alpha, widest);
+    }
+    const double y = 2.0 * 0.69314718055994531 / kTiltHalflifeS;
+    return 2.0 * y / 2.718281828459045 * std::tan(alpha);
+}
+}  // namespace
+
+TEST_CASE("step_tilt_normal: generated ground normals, unit, rate-bounded, converging, reproducible", "[foot_placement][tilt]") {
+    std::uint32_t seed = 2026u;
+    const std::function<float()> next = [&] {
+        seed = seed * 1664525u + 1013904223u;
+        return static_cast<float>(seed >> 8) / 16777216.0f;
+    };
+    double worst_ratio = 0.0, worst_single_step_deg_s = 0.0;
+    for (int n = 0; n < 400; ++n) {
+        const int kind = n % 4;
+        const TiltCase c = generate_tilt_case(kind, next);
+        const std::vector<vec3> out = run_tilt_spring(c);
+        const double bound = tilt_turn_bound(c.goals);
+        INFO("case " << n << " kind " << kind << " dt " << c.dt << " ticks " << c.goals.size() << " bound " << bound);
+        double fastest = 0.0;
+        float length_error = 0.0f;
+        for (size_t t = 0; t < out.size(); ++t) {
+            const vec3 v = out[t];
+            length_error = std::max(length_error, std::abs(std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z) - 1.0f));
+            if (t > 0) fastest = std::max(fastest, angle_between(out[t - 1], v) / c.dt);
+        }
+        CHECK(length_error <= 1e-6f);
+        CHECK(fastest <= bound * 1.01 + 1e-4);
+        if (bound > 0.0) worst_ratio = std::max(worst_ratio, fastest / bound);
+        // Held 1 s (20 halflives): on the held normal to float precision.
+        CHECK(angle_between(out.back(), c.goals.back()) <= 1e-5);
+        // Bit-reproducible: the same goals give the same bits.
+        const std::vector<vec3> again = run_tilt_spring(c);
+        CHECK(std::memcmp(out.data(), again.data(), out.size() * sizeof(vec3)) == 0);
+    }
+    // A single step of θ from rest (a crease crossed once): ≤ (2y/e)·tan(θ/2);
+    // 15° (the default slope) at 240 Hz turns the foot at most ~154 °/s.
+    for (int n = 0; n < 100; ++n) {
+        TiltCase c;
+        c.dt = 1.0f / static_cast<float>(30 + static_cast<int>(1970.0f * next()));
+        const float theta = 1.0471976f * next();
+        const vec3 from = normal_at(0.5f * next(), 6.2831853f * next());
+        vec3 to = normal_at(theta, 6.2831853f * next());
+        // `to` turned so that it is θ from `from`: build it in from's frame.
+        const vec3 side = std::abs(from.x) < 0.9f ? vec3(1.0f, 0.0f, 0.0f) : vec3(0.0f, 0.0f, 1.0f);
+        vec3 u = side - from * (side.x * from.x + side.y * from.y + side.z * from.z);
+        u /= std::sqrt(u.x * u.x + u.y * u.y + u.z * u.z);
+        to = from * std::cos(theta) + u * std::sin(theta);
+        c.goals.assign(1, from);
+        c.goals.insert(c.goals.end(), static_cast<size_t>(1.0f / c.dt), to);
+        const std::vector<vec3> out = run_tilt_spring(c);
+        double fastest = 0.0;
+        for (size_t t = 1; t < out.size(); ++t) fastest = std::max(fastest, angle_between(out[t - 1], out[t]) / c.dt);
+        const double y = 2.0 * 0.69314718055994531 / kTiltHalflifeS;
+        const double bound = 2.0 * y / 2.718281828459045 * std::tan(0.5 * theta);
+        INFO("step " << n << " theta " << theta << " dt " << c.dt);
+        CHECK(fastest <= bound * 1.01 + 1e-4);
+        if (std::abs(theta - 0.2618f) < 0.05f) worst_single_step_deg_s = std::max(worst_single_step_deg_s, fastest * 57.29578);
+    }
+    // The bound is not loose by orders of magnitude (a snap would read 10–100×).
+    CHECK(worst_ratio > 0.2);
+    WARN("fastest turn over its bound " << worst_ratio << "; ~15° single steps up to " << worst_single_step_deg_s << " °/s");
 }
