@@ -55,7 +55,6 @@ quat quat_from_to(vec3 from, vec3 to) {
     return quat_normalize(quat(1.0f + d, c.x, c.y, c.z));
 }
 
-namespace {
 TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkJob& in) {
     TwoBoneIkResult out;
     const float a = in.upper_length;
@@ -119,7 +118,6 @@ TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkJob& in) {
     out.reached = dot3(miss, miss) <= 1e-8f;
     return out;
 }
-}  // namespace
 
 bool TwoBoneIkJob::run() const {
     if (!validate()) return false;

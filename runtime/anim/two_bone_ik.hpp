@@ -47,6 +47,12 @@ struct TwoBoneIkJob {
     [[nodiscard]] bool run() const;
 };
 
+// The solve run() performs once validate() passed, without the check: for a
+// job (GaitPoseJob) whose own validate() already covered these inputs (positive,
+// finite lengths, finite root, target and pole), so a tick validates once.
+// Inputs validate() would refuse give unspecified values (no crash, no UB).
+TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkJob& job);
+
 // Rotation whose columns are the given orthonormal axes (right-handed), via
 // Shepperd's method: sqrt only.
 quat quat_from_axes(vec3 x_axis, vec3 y_axis, vec3 z_axis);

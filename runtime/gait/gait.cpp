@@ -4,6 +4,7 @@
 
 #include "runtime/gait/puppet.hpp"
 #include "runtime/gait/steering.hpp"
+#include "runtime/anim/local_to_model.hpp"
 #include "runtime/anim/skeleton.hpp"
 #include "runtime/anim/two_bone_ik.hpp"
 
@@ -388,9 +389,9 @@ void build_swing_path(FootState& f, const Terrain& whole_terrain, const GaitRig&
             f.path_height[k] = maxf(f.path_height[k], f.path_height[static_cast<std::size_t>(jj)] - kMaxPathGrade * d);
         }
     }
-    std::array<HermiteKey, kSwingPathKeys> keys{};
-    swing_path_keys(f, travel, keys);
-    f.path_length = build_arc_length_table(keys);
+    f.path_travel = travel;
+    swing_path_keys(f, travel, f.path_keys);
+    f.path_length = build_arc_length_table(f.path_keys);
 }
 
 // How much of the mid-swing reach allowance (kFullLegReachShare over the
@@ -437,10 +438,8 @@ SwingPoint swing_point(const FootState& f, int foot, const GaitRig& rig, float b
     const float u = clampf(progress, 0.0f, 1.0f);
     const vec3 shape = blended_swing(rig, blend, u);  // (sideways, lift, share of the path)
     const float share = clampf(shape.z, 0.0f, 1.0f);
-    const float distance = swing_travel(f, rig);  // once: the keys are built from it too
-    std::array<HermiteKey, kSwingPathKeys> keys{};
-    swing_path_keys(f, distance, keys);
-    const std::span<const HermiteKey> path(keys.data(), keys.size());
+    const float distance = f.path_travel;  // the keys and travel of the swing, built at its start
+    const std::span<const HermiteKey> path(f.path_keys.data(), f.path_keys.size());
     const float total = f.path_length.total();
     const float s = total > 1e-6f ? clampf(time_at_arc_length(path, f.path_length, share * total), 0.0f, 1.0f) : share;
     const vec3 on_path = sample_hermite(path, s).position;  // (0, height, travel along the step)
@@ -881,7 +880,8 @@ Placement aim_swing(const GaitState& g, const GaitTick& t, vec3 root, int i, flo
 // at kMaxMeanSwingSpeed. A foot lifting (or re-aimed) late in its phase had the
 // cycle's few remaining hundredths of a second for up to 0.9 m: its shin passed
 // 1500 °/s (wall × reversals after a long stop swing, 1506 °/s).
-float shortest_swing(const FootState& f, const GaitRig& rig) { return maxf(kShortestSwing, swing_travel(f, rig) / kMaxMeanSwingSpeed); }
+// f.path_travel is swing_travel(f, rig), computed once at the swing's start.
+float shortest_swing(const FootState& f) { return maxf(kShortestSwing, f.path_travel / kMaxMeanSwingSpeed); }
 
 // Starts (or re-aims) foot i's phase-driven swing at its phase psi, aimed for
 // the time it will take. A swing held to its travel at kMaxMeanSwingSpeed
@@ -895,7 +895,7 @@ void begin_aimed_swing(GaitState& g, const GaitTick& t, vec3 root, int i, float 
     begin_swing(f, aim_swing(g, t, root, i, remaining), t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
     if (!(t.dphase > 0.0f)) return;
     const float phase_time = maxf(kMinSwingPhaseShare, remaining) * t.dt / t.dphase;
-    const float swing_time = shortest_swing(f, t.rig);
+    const float swing_time = shortest_swing(f);
     if (swing_time > phase_time)
         begin_swing(f, aim_swing(g, t, root, i, swing_time * t.dphase / t.dt), t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
 }
@@ -915,7 +915,7 @@ float swing_phase_now(const FootState& f, float cycle_phase, int i) {
 // kShortestSwing swing.
 float swing_rate(const FootState& f, const GaitTick& t) {
     return f.timed_rate > 0.0f ? f.timed_rate
-                               : minf(t.dphase / t.dt / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), 1.0f / shortest_swing(f, t.rig));
+                               : minf(t.dphase / t.dt / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), 1.0f / shortest_swing(f));
 }
 
 // Where a swing's hip will be when it lands, if the root keeps its speed and heading.
@@ -963,7 +963,7 @@ void advance_swing(GaitState& g, const GaitTick& t, vec3 root, int i) {
     FootState& f = g.feet[static_cast<std::size_t>(i)];
     const float rate = f.timed_rate > 0.0f
                            ? f.timed_rate * t.dt
-                           : minf(t.dphase / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), t.dt / shortest_swing(f, t.rig));
+                           : minf(t.dphase / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), t.dt / shortest_swing(f));
     f.progress += rate;
     if (f.progress >= 1.0f) {
         land(f, g);
@@ -1183,14 +1183,10 @@ namespace {
 bool finite3(vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 bool positive_length(float metres) { return metres > 0.0f && std::isfinite(metres); }
 
-// Runs an IK job whose inputs GaitPoseJob::validate() vouched for (positive
-// bone lengths, a finite state), so it cannot fail.
-TwoBoneIkResult solve_limb(TwoBoneIkJob ik) {
-    TwoBoneIkResult result;
-    ik.result = &result;
-    expect_job_ran(ik.run());
-    return result;
-}
+// Solves an IK job whose inputs GaitPoseJob::validate() vouched for (positive,
+// finite bone lengths, a finite state): validated once per pose, not again per
+// limb (TwoBoneIkJob::run would repeat the check four times a tick).
+TwoBoneIkResult solve_limb(const TwoBoneIkJob& ik) { return solve_two_bone_ik(ik); }
 }  // namespace
 
 bool GaitPoseJob::validate() const {
@@ -1200,7 +1196,7 @@ bool GaitPoseJob::validate() const {
         return false;
     const GaitRig& r = *rig;
     return positive_length(r.thigh) && positive_length(r.shin) && positive_length(r.upper_arm) &&
-           positive_length(r.forearm) && std::isfinite(heading) && finite3(gait->pelvis) &&
+           positive_length(r.forearm) && std::isfinite(r.hip_half_width) && std::isfinite(heading) && finite3(gait->pelvis) &&
            finite3(gait->feet[0].ankle) && finite3(gait->feet[1].ankle);
 }
 
@@ -1244,7 +1240,9 @@ bool GaitPoseJob::run() const {
         pose.local_rotations[thigh + 1] = quat_normalize(quat_mul(quat_conjugate(s.upper_rotation), s.lower_rotation));
         pose.local_rotations[thigh + 2] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), f.rotation));
     }
-    expect_job_ran(LocalToModelJob{parents, pose.local(), pose.model()}.run());
+    // validate() checked what LocalToModelJob::validate() would (span sizes,
+    // parents in order): its kernel runs directly.
+    fk::local_to_model_vector(parents, pose.local(), pose.model());
 
     // Arms: the hands follow the blended hand paths, swinging against the legs;
     // elbows point back.

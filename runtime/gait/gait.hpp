@@ -49,6 +49,13 @@ struct FootState {
     // table (the foot's progress along it is by length: docs/gait.md).
     std::array<float, kSwingPathKeys> path_height{};
     ArcLengthTable path_length{};
+    // Derived from the fields above when the path is built (begin_swing), and
+    // fixed for the swing: its Hermite keys (path_height against the step
+    // fraction) and the swing's travel (swing_travel), so a tick evaluates the
+    // swing without rebuilding them. Not hashed: a function of hashed fields and
+    // the skeleton's proportions, which retune cannot change.
+    std::array<HermiteKey, kSwingPathKeys> path_keys{};
+    float path_travel = 0.0f;
 };
 
 struct GaitState {
@@ -149,7 +156,9 @@ struct GaitPoseJob {
 
     // False without a state, rig or config, with spans not of the puppet's joint
     // count, parents out of order, a bone length that is not positive, or a
-    // state the IK cannot solve (not finite).
+    // state the IK cannot solve (not finite). run() checks this once and then
+    // runs the four IK solves and forward kinematics without their own checks
+    // (it covers theirs); the rest offsets are the caller's skeleton, not checked.
     bool validate() const;
     [[nodiscard]] bool run() const;
 };
