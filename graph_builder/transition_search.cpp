@@ -1,15 +1,18 @@
 #include "graph_builder/transition_search.hpp"
 
 #include <cblas.h>
+#include <sys/mman.h>
 
 #include <algorithm>
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <limits>
 #include <map>
+#include <new>
 #include <memory>
 #include <stdexcept>
 #include <thread>
@@ -396,28 +399,54 @@ MARIONETTE_VECTOR_CLONES void window_distances(const double* __restrict sums, st
     }
 }
 
-// A scratch array that grows but is never value-initialised: the tile buffers are
-// megabytes, every cell is written (dgemm with beta 0, the distance rows) before
-// it is read, and zero-filling them at every size change cost as much as the dgemm.
-template <typename T>
-struct ScratchArray {
-    std::unique_ptr<T[]> data_;
-    size_t size_ = 0;
-    void ensure(size_t n) {
-        if (n > size_) data_.reset(new T[n]), size_ = n;
+// A tile's large scratch arrays, its products' ring (ca, cb, cy: doubles) and both bounds
+// of its box (box_lo, box_hi: floats), in one block that grows but is never value-
+// initialised: every cell is written (dgemm with beta 0, the distance rows) before it is
+// read, and zero-filling them at every size change cost as much as the dgemm. The block is
+// 2 MiB-aligned and asks for transparent huge pages (Linux madvise, where the kernel allows
+// them): a search's fresh block is then first touched in two 2 MiB pages instead of ~800
+// 4 KiB page faults, which were ~40 % of a 1 010-frame search's CPU time (docs/motion-graph.md,
+// "Fixed costs"). Only the speed depends on it: no value does.
+class TileBuffers {
+public:
+    double* ca = nullptr;  // per-frame cross terms of the box (dgemm), `ring_cells` each
+    double* cb = nullptr;
+    double* cy = nullptr;
+    float* box_lo = nullptr;  // lower and upper bounds of the box's distances, `box_cells` each
+    float* box_hi = nullptr;
+    void ensure(size_t ring_cells, size_t box_cells) {
+        if (ring_cells <= ring_cells_ && box_cells <= box_cells_) return;
+        ring_cells_ = std::max(ring_cells, ring_cells_), box_cells_ = std::max(box_cells, box_cells_);
+        constexpr size_t kHugePage = size_t{2} << 20;
+        const size_t bytes = 3 * ring_cells_ * sizeof(double) + 2 * box_cells_ * sizeof(float);
+        const size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+        block_.reset();
+        block_.reset(static_cast<std::byte*>(std::aligned_alloc(kHugePage, rounded)));
+        if (!block_) throw std::bad_alloc();
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+        madvise(block_.get(), rounded, MADV_HUGEPAGE);  // advice only: refused, the pages are 4 KiB
+#endif
+        ca = reinterpret_cast<double*>(block_.get());
+        cb = ca + ring_cells_;
+        cy = cb + ring_cells_;
+        box_lo = reinterpret_cast<float*>(cy + ring_cells_);
+        box_hi = box_lo + box_cells_;
     }
-    T* data() { return data_.get(); }
-    const T* data() const { return data_.get(); }
-    T& operator[](size_t i) { return data_[i]; }
+
+private:
+    struct Free {
+        void operator()(std::byte* p) const { std::free(p); }
+    };
+    std::unique_ptr<std::byte, Free> block_;
+    size_t ring_cells_ = 0, box_cells_ = 0;
 };
 
 struct TileScratch {
-    ScratchArray<double> ca, cb, cy;      // per-frame cross terms of the tile (dgemm)
+    TileBuffers buffers;                  // the products' ring and the box's bounds
     std::vector<double> row_cx, row_cz, col_cx, col_cz;  // frame centroids of its rows and columns
     std::vector<double> sums[2];          // window sums of the previous and the current row
     std::vector<double> col_spread, col_x, col_z;  // per column's window B
     std::vector<std::int32_t> invalid_cols;
-    ScratchArray<float> box_lo, box_hi;   // lower and upper bounds of the distances of a computed box
     std::vector<std::uint8_t> mask;       // a tile line's cells that may be kept
     std::vector<std::pair<std::int32_t, std::int32_t>> cells, sorted;  // a tile's cells that may be kept
     std::vector<size_t> row_start;        // (counting sort of the cells by row)
@@ -650,7 +679,7 @@ TileSpan tile_span(const FrameFeatures& f, std::int32_t h, std::int32_t i0, std:
 constexpr std::int32_t kBand = 64;
 
 // The bounds [lo, hi] of every pair i ∈ [ei0, ei1), j ∈ [ej0, ej1) (valid: i < N − k + 1,
-// j ≥ k − 1) into s.box_lo / s.box_hi, rows ej1 − ej0 apart: three dgemm products of
+// j ≥ k − 1) into s.buffers.box_lo / box_hi, rows ej1 − ej0 apart: three dgemm products of
 // the frames, the window sums slid along the diagonals, the distances in double.
 
 void fill_region(const FrameFeatures& f, const CandidateSearchOptions& o, const DistanceErrorBound& bound,
@@ -664,9 +693,10 @@ void fill_region(const FrameFeatures& f, const CandidateSearchOptions& o, const 
     // sums read stays in the core's cache instead of streaming megabytes through memory.
     const std::int32_t ring = std::min(nr, kBand + k);
     const size_t ucols = static_cast<size_t>(nc);
-    s.ca.ensure(static_cast<size_t>(ring) * ucols);
-    s.cb.ensure(static_cast<size_t>(ring) * ucols);
-    s.cy.ensure(static_cast<size_t>(ring) * ucols);
+    const std::int32_t dr = ei1 - ei0, dc = ej1 - ej0;
+    const size_t udc = static_cast<size_t>(dc);
+    s.buffers.ensure(static_cast<size_t>(ring) * ucols, static_cast<size_t>(dr) * udc);
+    TileBuffers& b = s.buffers;
     std::int32_t made = 0;  // rows [0, made) were made; the ring holds the last `ring` of them
     // Rows up to `last` (r + k − 1 for row r, which reads product rows r − 1 … r + k − 1): a band
     // starts at made ≤ last and overwrites rows up to made − ring + kBand − 1 ≤ last − k − 1 = r − 2.
@@ -674,28 +704,26 @@ void fill_region(const FrameFeatures& f, const CandidateSearchOptions& o, const 
         while (made <= last) {
             const std::int32_t slot = made % ring, rows = std::min({kBand, nr - made, ring - slot});
             const size_t at = static_cast<size_t>(slot) * ucols;
-            row_dots(f.xz.data(), row0 + made, rows, f.xz.data(), col0, nc, width, s.ca.data() + at);
-            row_dots(f.xz.data(), row0 + made, rows, f.zx.data(), col0, nc, width, s.cb.data() + at);
-            row_dots(f.y.data(), row0 + made, rows, f.y.data(), col0, nc, J, s.cy.data() + at);
+            row_dots(f.xz.data(), row0 + made, rows, f.xz.data(), col0, nc, width, b.ca + at);
+            row_dots(f.xz.data(), row0 + made, rows, f.zx.data(), col0, nc, width, b.cb + at);
+            row_dots(f.y.data(), row0 + made, rows, f.y.data(), col0, nc, J, b.cy + at);
             if (o.product_noise > 0.0) {
-                perturb_products(s.ca.data() + at, row0 + made, rows, col0, nc, o.product_noise * bound.product_xz, 0);
-                perturb_products(s.cb.data() + at, row0 + made, rows, col0, nc, o.product_noise * bound.product_xz, 1);
-                perturb_products(s.cy.data() + at, row0 + made, rows, col0, nc, o.product_noise * bound.product_y, 2);
+                perturb_products(b.ca + at, row0 + made, rows, col0, nc, o.product_noise * bound.product_xz, 0);
+                perturb_products(b.cb + at, row0 + made, rows, col0, nc, o.product_noise * bound.product_xz, 1);
+                perturb_products(b.cy + at, row0 + made, rows, col0, nc, o.product_noise * bound.product_y, 2);
             }
             made += rows;
         }
     };
 
-    const std::int32_t dr = ei1 - ei0, dc = ej1 - ej0;
     s.row_cx.assign(f.cx.begin() + row0, f.cx.begin() + row0 + nr);
     s.row_cz.assign(f.cz.begin() + row0, f.cz.begin() + row0 + nr);
     s.col_cx.assign(f.cx.begin() + col0, f.cx.begin() + col0 + nc);
     s.col_cz.assign(f.cz.begin() + col0, f.cz.begin() + col0 + nc);
-    const TileTerms terms{s.ca.data(), s.cb.data(), s.cy.data(), s.row_cx.data(), s.row_cz.data(),
+    const TileTerms terms{b.ca, b.cb, b.cy, s.row_cx.data(), s.row_cz.data(),
                           s.col_cx.data(), s.col_cz.data(), ucols, static_cast<size_t>(ring)};
 
     // Per column: window B's spread and W/k · Σ centroid; columns whose window leaves its clip.
-    const size_t udc = static_cast<size_t>(dc);
     s.col_spread.resize(udc);
     s.col_x.resize(udc);
     s.col_z.resize(udc);
@@ -710,8 +738,6 @@ void fill_region(const FrameFeatures& f, const CandidateSearchOptions& o, const 
     }
     // Window sums row by row: row 0 and column 0 directly, the rest by sliding along
     // the diagonals (two double adds per sum and pair instead of k).
-    s.box_lo.ensure(static_cast<size_t>(dr) * udc);
-    s.box_hi.ensure(static_cast<size_t>(dr) * udc);
     s.sums[0].resize(kSumCount * udc);
     s.sums[1].resize(kSumCount * udc);
     const double inv_wk = 1.0 / (f.weight * k);
@@ -727,8 +753,8 @@ void fill_region(const FrameFeatures& f, const CandidateSearchOptions& o, const 
         }
         const std::int32_t i = ei0 + r;
         const size_t ui = static_cast<size_t>(i);
-        float* __restrict lo = s.box_lo.data() + static_cast<size_t>(r) * udc;
-        float* __restrict hi = s.box_hi.data() + static_cast<size_t>(r) * udc;
+        float* __restrict lo = b.box_lo + static_cast<size_t>(r) * udc;
+        float* __restrict hi = b.box_hi + static_cast<size_t>(r) * udc;
         if (!f.start_ok[ui]) {
             std::fill(lo, lo + dc, kPairInvalid);
             std::fill(hi, hi + dc, kPairInvalid);
@@ -771,16 +797,16 @@ void run_tile_pair(const FrameFeatures& f, const CandidateSearchOptions& o, cons
     const size_t stride = static_cast<size_t>(c1 - c0);
     if (!p.empty()) {
         const size_t at = static_cast<size_t>(p.ei0 - r0) * stride + static_cast<size_t>(p.ej0 - c0);
-        p.lo = s.box_lo.data() + at, p.lo_i_step = stride, p.lo_j_step = 1;
-        p.hi = s.box_hi.data() + at, p.hi_i_step = stride, p.hi_j_step = 1;
+        p.lo = s.buffers.box_lo + at, p.lo_i_step = stride, p.lo_j_step = 1;
+        p.hi = s.buffers.box_hi + at, p.hi_i_step = stride, p.hi_j_step = 1;
         decide_tile_minima(f, o, p, s);
     }
     if (q.empty()) return;
     // q[r][c] = box[c + q.ej0 − k + 1 − r0][r + q.ei0 + k − 1 − c0]: both bounds read in place,
     // transposed (decide_tile_minima scans such a tile along the box's rows).
     const size_t br = static_cast<size_t>(q.ej0 - k + 1 - r0), bc = static_cast<size_t>(q.ei0 + k - 1 - c0);
-    q.lo = s.box_lo.data() + br * stride + bc, q.lo_i_step = 1, q.lo_j_step = stride;
-    q.hi = s.box_hi.data() + br * stride + bc, q.hi_i_step = 1, q.hi_j_step = stride;
+    q.lo = s.buffers.box_lo + br * stride + bc, q.lo_i_step = 1, q.lo_j_step = stride;
+    q.hi = s.buffers.box_hi + br * stride + bc, q.hi_i_step = 1, q.hi_j_step = stride;
     decide_tile_minima(f, o, q, s);
 }
 
@@ -805,8 +831,7 @@ CandidateSearchResult find_transition_candidates(const FrameFeatures& f, const C
         const size_t frames = side + static_cast<size_t>(f.window) - 1;
         const size_t ring = std::min(frames, static_cast<size_t>(kBand + f.window));
         for (TileScratch& s : scratch) {
-            s.ca.ensure(ring * frames), s.cb.ensure(ring * frames), s.cy.ensure(ring * frames);
-            s.box_lo.ensure(side * side), s.box_hi.ensure(side * side);
+            s.buffers.ensure(ring * frames, side * side);
         }
     }
     if (o.plot)
