@@ -1,15 +1,18 @@
 #include "graph_builder/transition_search.hpp"
 
 #include <cblas.h>
+#include <sys/mman.h>
 
 #include <algorithm>
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <limits>
 #include <map>
+#include <new>
 #include <memory>
 #include <stdexcept>
 #include <thread>
@@ -279,13 +282,13 @@ std::vector<double> distance_percentiles(const FrameFeatures& f, const std::vect
 
 namespace {
 
-// out[r][c] = row (a_first + r) of `a` · row (b_first + c) of `b`, r < a_rows,
-// c < b_rows, rows `width` floats long: every cross term of a tile is one sgemm.
+// out[r * ldc + c] = row (a_first + r) of `a` · row (b_first + c) of `b`, r < a_rows,
+// c < b_rows, rows `width` doubles long: every cross term of a tile is one dgemm.
 void row_dots(const double* a, std::int32_t a_first, std::int32_t a_rows, const double* b, std::int32_t b_first,
-              std::int32_t b_rows, int width, double* out) {
+              std::int32_t b_rows, int width, double* out, std::int32_t ldc) {
     cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasTrans, a_rows, b_rows, width, 1.0,
                 a + static_cast<size_t>(a_first) * static_cast<size_t>(width), width,
-                b + static_cast<size_t>(b_first) * static_cast<size_t>(width), width, 0.0, out, b_rows);
+                b + static_cast<size_t>(b_first) * static_cast<size_t>(width), width, 0.0, out, ldc);
 }
 
 // The per-row kernels of a tile are cloned for wider vector units where the
@@ -321,9 +324,11 @@ struct TileTerms {
 // Row r's sums from row r − 1's: pair (r, c)'s k-frame diagonal is pair
 // (r − 1, c − 1)'s with frame pair (r + k − 1, c + k − 1) entering and
 // (r − 1, c − 1) leaving. Double sums of float products are exact to ~1e-16, so
-// (the products are doubles: sliding along 500 diagonal steps costs ~1e-13). Columns c ≥ 1 only.
+// (the products are doubles: sliding along 500 diagonal steps costs ~1e-13). Columns
+// c ∈ [c_begin, c_end), c_begin ≥ 1, of rows dc sums long.
 MARIONETTE_VECTOR_CLONES void slide_window_sums(const TileTerms& m, std::int32_t r, std::int32_t k, std::int32_t dc,
-                                                const double* __restrict prev, double* __restrict cur) {
+                                                std::int32_t c_begin, std::int32_t c_end, const double* __restrict prev,
+                                                double* __restrict cur) {
     const size_t in = m.row_at(static_cast<size_t>(r + k - 1)) + static_cast<size_t>(k - 1);
     const size_t out = m.row_at(static_cast<size_t>(r - 1));
     const size_t n = static_cast<size_t>(dc);
@@ -333,7 +338,7 @@ MARIONETTE_VECTOR_CLONES void slide_window_sums(const TileTerms& m, std::int32_t
     const double* __restrict cross_out = m.cross + out;
     const double* __restrict y_in = m.y + in;
     const double* __restrict y_out = m.y + out;
-    for (size_t c = 1; c < n; ++c) {
+    for (size_t c = static_cast<size_t>(c_begin); c < static_cast<size_t>(c_end); ++c) {
         cur[c] = prev[c - 1] + dot_in[c] - dot_out[c - 1];
         cur[n + c] = prev[n + c - 1] + cross_in[c] - cross_out[c - 1];
         cur[2 * n + c] = prev[2 * n + c - 1] + y_in[c] - y_out[c - 1];
@@ -343,7 +348,7 @@ MARIONETTE_VECTOR_CLONES void slide_window_sums(const TileTerms& m, std::int32_t
     const double* __restrict cz_in = m.col_cz + (k - 1);
     const double* __restrict cx_out = m.col_cx;
     const double* __restrict cz_out = m.col_cz;
-    for (size_t c = 1; c < n; ++c) {
+    for (size_t c = static_cast<size_t>(c_begin); c < static_cast<size_t>(c_end); ++c) {
         cur[3 * n + c] = prev[3 * n + c - 1] + (ex * cx_in[c] + ez * cz_in[c]) - (lx * cx_out[c - 1] + lz * cz_out[c - 1]);
         cur[4 * n + c] = prev[4 * n + c - 1] + (ex * cz_in[c] - ez * cx_in[c]) - (lx * cz_out[c - 1] - lz * cx_out[c - 1]);
     }
@@ -375,13 +380,15 @@ struct RowWindow {
 // D = S_A + S_B − 2Y − 2√(dot² + cross²). Not the value kept: what comes out is the
 // interval [lo, hi] (v ∓ bound, through the noise floor, rounded to float) that holds
 // the fixed-order kernel's float for the pair, whatever the BLAS kernel's rounding.
-// col_x, col_z: W/k · Σ_t centroid of each column's window B.
-MARIONETTE_VECTOR_CLONES void window_distances(const double* __restrict sums, std::int32_t dc, RowWindow a, double weight,
+// col_x, col_z: W/k · Σ_t centroid of each column's window B. `count` columns from the
+// first of each array; the five sums are `stride` apart.
+MARIONETTE_VECTOR_CLONES void window_distances(const double* __restrict sums, size_t stride, size_t count, RowWindow a,
+                                               double weight,
                                                double inv_wk, double bound, const double* __restrict col_spread,
                                                const double* __restrict col_x, const double* __restrict col_z,
                                                float* __restrict lo_out, float* __restrict hi_out) {
-    const size_t n = static_cast<size_t>(dc);
-    for (size_t c = 0; c < n; ++c) {
+    const size_t n = stride;
+    for (size_t c = 0; c < count; ++c) {
         const double dot = sums[c] + (weight * sums[3 * n + c] - (a.sum_x * col_x[c] + a.sum_z * col_z[c]));
         const double cross = sums[n + c] + (weight * sums[4 * n + c] - (a.sum_x * col_z[c] - a.sum_z * col_x[c]));
         const double d = a.spread + col_spread[c] - 2.0 * sums[2 * n + c] - 2.0 * std::sqrt(dot * dot + cross * cross);
@@ -396,28 +403,54 @@ MARIONETTE_VECTOR_CLONES void window_distances(const double* __restrict sums, st
     }
 }
 
-// A scratch array that grows but is never value-initialised: the tile buffers are
-// megabytes, every cell is written (dgemm with beta 0, the distance rows) before
-// it is read, and zero-filling them at every size change cost as much as the dgemm.
-template <typename T>
-struct ScratchArray {
-    std::unique_ptr<T[]> data_;
-    size_t size_ = 0;
-    void ensure(size_t n) {
-        if (n > size_) data_.reset(new T[n]), size_ = n;
+// A tile's large scratch arrays, its products' ring (ca, cb, cy: doubles) and both bounds
+// of its box (box_lo, box_hi: floats), in one block that grows but is never value-
+// initialised: every cell is written (dgemm with beta 0, the distance rows) before it is
+// read, and zero-filling them at every size change cost as much as the dgemm. The block is
+// 2 MiB-aligned and asks for transparent huge pages (Linux madvise, where the kernel allows
+// them): a search's fresh block is then first touched in two 2 MiB pages instead of ~800
+// 4 KiB page faults, which were ~40 % of a 1 010-frame search's CPU time (docs/motion-graph.md,
+// "Fixed costs"). Only the speed depends on it: no value does.
+class TileBuffers {
+public:
+    double* ca = nullptr;  // per-frame cross terms of the box (dgemm), `ring_cells` each
+    double* cb = nullptr;
+    double* cy = nullptr;
+    float* box_lo = nullptr;  // lower and upper bounds of the box's distances, `box_cells` each
+    float* box_hi = nullptr;
+    void ensure(size_t ring_cells, size_t box_cells) {
+        if (ring_cells <= ring_cells_ && box_cells <= box_cells_) return;
+        ring_cells_ = std::max(ring_cells, ring_cells_), box_cells_ = std::max(box_cells, box_cells_);
+        constexpr size_t kHugePage = size_t{2} << 20;
+        const size_t bytes = 3 * ring_cells_ * sizeof(double) + 2 * box_cells_ * sizeof(float);
+        const size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+        block_.reset();
+        block_.reset(static_cast<std::byte*>(std::aligned_alloc(kHugePage, rounded)));
+        if (!block_) throw std::bad_alloc();
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+        madvise(block_.get(), rounded, MADV_HUGEPAGE);  // advice only: refused, the pages are 4 KiB
+#endif
+        ca = reinterpret_cast<double*>(block_.get());
+        cb = ca + ring_cells_;
+        cy = cb + ring_cells_;
+        box_lo = reinterpret_cast<float*>(cy + ring_cells_);
+        box_hi = box_lo + box_cells_;
     }
-    T* data() { return data_.get(); }
-    const T* data() const { return data_.get(); }
-    T& operator[](size_t i) { return data_[i]; }
+
+private:
+    struct Free {
+        void operator()(std::byte* p) const { std::free(p); }
+    };
+    std::unique_ptr<std::byte, Free> block_;
+    size_t ring_cells_ = 0, box_cells_ = 0;
 };
 
 struct TileScratch {
-    ScratchArray<double> ca, cb, cy;      // per-frame cross terms of the tile (dgemm)
+    TileBuffers buffers;                  // the products' ring and the box's bounds
     std::vector<double> row_cx, row_cz, col_cx, col_cz;  // frame centroids of its rows and columns
     std::vector<double> sums[2];          // window sums of the previous and the current row
     std::vector<double> col_spread, col_x, col_z;  // per column's window B
     std::vector<std::int32_t> invalid_cols;
-    ScratchArray<float> box_lo, box_hi;   // lower and upper bounds of the distances of a computed box
     std::vector<std::uint8_t> mask;       // a tile line's cells that may be kept
     std::vector<std::pair<std::int32_t, std::int32_t>> cells, sorted;  // a tile's cells that may be kept
     std::vector<size_t> row_start;        // (counting sort of the cells by row)
@@ -431,8 +464,8 @@ struct TileScratch {
 
 // Tests only (CandidateSearchOptions::product_noise): every product of a tile moved
 // by a pseudo-random amount within ±scale, fixed per (frame pair, product kind).
-void perturb_products(double* c, std::int32_t row0, std::int32_t nr, std::int32_t col0, std::int32_t nc, double scale,
-                      std::uint64_t kind) {
+void perturb_products(double* c, size_t ldc, std::int32_t row0, std::int32_t nr, std::int32_t col0, std::int32_t nc,
+                      double scale, std::uint64_t kind) {
     for (std::int32_t r = 0; r < nr; ++r)
         for (std::int32_t q = 0; q < nc; ++q) {
             std::uint64_t x = (static_cast<std::uint64_t>(row0 + r) << 32 | static_cast<std::uint32_t>(col0 + q)) ^ (kind << 62);
@@ -441,7 +474,7 @@ void perturb_products(double* c, std::int32_t row0, std::int32_t nr, std::int32_
             x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
             x ^= x >> 31;
             const double unit = static_cast<double>(x >> 11) * 0x1p-52 - 1.0;  // [−1, 1)
-            c[static_cast<size_t>(r) * static_cast<size_t>(nc) + static_cast<size_t>(q)] += scale * unit;
+            c[static_cast<size_t>(r) * ldc + static_cast<size_t>(q)] += scale * unit;
         }
 }
 
@@ -644,57 +677,99 @@ TileSpan tile_span(const FrameFeatures& f, std::int32_t h, std::int32_t i0, std:
     return t;
 }
 
+// A box whose rows and columns are the same windows (a diagonal tile pair, a = b): row r is
+// window A = ei0 + r, column c window B = col0 + c = ei0 − δ + c, so cell (r, c) and cell
+// (c − δ, r + δ) hold the same two windows (the window distance is symmetric, and so are
+// the pair validity and the near-diagonal exclusion), and both intervals hold the
+// fixed-order kernel's float for either (see run_tile_pair). Row r < partial_rows leaves its
+// gap [δ, r + δ) to be copied from those mirror cells, computed in earlier rows (column
+// r + δ lies in the box); the other rows and the columns [0, δ) (mirrors outside the box)
+// are computed. Such a box costs about half of one computed whole.
+struct BoxMirror {
+    std::int32_t delta = 0;         // ei0 − col0
+    std::int32_t partial_rows = 0;  // 0: nothing is mirrored
+    std::int32_t strip_products = 0;  // product columns [0, strip_products) the columns [0, δ) read
+    std::int32_t gap_begin(std::int32_t r) const { return r < partial_rows ? delta : 0; }
+    std::int32_t gap_end(std::int32_t r) const { return r < partial_rows ? r + delta : 0; }
+};
+
+BoxMirror box_mirror(bool symmetric, std::int32_t delta, std::int32_t dr, std::int32_t dc, std::int32_t k) {
+    BoxMirror m;
+    if (!symmetric || delta < 0 || delta >= dc) return m;
+    m.delta = delta;
+    m.partial_rows = std::min(dr, dc - delta);
+    m.strip_products = delta > 0 ? delta + k - 1 : 0;
+    return m;
+}
+
+// Cells (r, c) of the gap of a mirrored box (BoxMirror) from (c − δ, r + δ), in blocks.
+void copy_mirrored(const BoxMirror& m, size_t stride, float* box) {
+    constexpr std::int32_t kBlock = 32;
+    const std::int32_t rows = m.partial_rows, d = m.delta;
+    for (std::int32_t r0 = 0; r0 < rows; r0 += kBlock) {
+        const std::int32_t r1 = std::min(r0 + kBlock, rows);
+        for (std::int32_t c0 = d; c0 < r1 - 1 + d; c0 += kBlock)
+            for (std::int32_t r = r0; r < r1; ++r)
+                for (std::int32_t c = c0, c1 = std::min(c0 + kBlock, r + d); c < c1; ++c)
+                    box[static_cast<size_t>(r) * stride + static_cast<size_t>(c)] =
+                        box[static_cast<size_t>(c - d) * stride + static_cast<size_t>(r + d)];
+    }
+}
+
 // Product rows per dgemm call (fill_region). 12 000 synthetic frames, CPU seconds of the
 // whole build: 32 rows 2.31, 64 2.29, 128 2.25, all rows at once 2.56 (each call repacks
 // the columns' operand, so small bands pay that; all at once streams the products through memory).
 constexpr std::int32_t kBand = 64;
 
-// The bounds [lo, hi] of every pair i ∈ [ei0, ei1), j ∈ [ej0, ej1) (valid: i < N − k + 1,
-// j ≥ k − 1) into s.box_lo / s.box_hi, rows ej1 − ej0 apart: three dgemm products of
-// the frames, the window sums slid along the diagonals, the distances in double.
-
-void fill_region(const FrameFeatures& f, const CandidateSearchOptions& o, const DistanceErrorBound& bound,
-                 std::int32_t ei0, std::int32_t ei1, std::int32_t ej0, std::int32_t ej1, TileScratch& s) {
-    const std::int32_t k = f.window;
-    const std::int32_t nr = ei1 - ei0 + k - 1, nc = ej1 - ej0 + k - 1;
-    const std::int32_t row0 = ei0, col0 = ej0 - k + 1;
-    const int J = f.joints, width = 2 * J;
-    // Cross terms of the box's frame pairs, C[r][c] = frame (row0+r) · frame (col0+c), made
-    // kBand rows at a time as the rows' sums need them, into a ring of kBand + k rows: what the
-    // sums read stays in the core's cache instead of streaming megabytes through memory.
-    const std::int32_t ring = std::min(nr, kBand + k);
-    const size_t ucols = static_cast<size_t>(nc);
-    s.ca.ensure(static_cast<size_t>(ring) * ucols);
-    s.cb.ensure(static_cast<size_t>(ring) * ucols);
-    s.cy.ensure(static_cast<size_t>(ring) * ucols);
+// The cross terms of a box's frame pairs, C[r][c] = frame (row0 + r) · frame (col0 + c), made
+// kBand rows at a time as the rows' sums need them, into a ring of kBand + k rows: what the
+// sums read stays in the core's cache instead of streaming megabytes through memory. A
+// mirrored box's product row R < partial_rows makes only the columns its rows read,
+// [0, strip_products) and [R + δ, nc) (its cells' diagonals stay at or right of c − r = δ).
+struct ProductRing {
+    const FrameFeatures& f;
+    const CandidateSearchOptions& o;
+    const DistanceErrorBound& bound;
+    const BoxMirror& mirror;
+    TileBuffers& b;
+    std::int32_t row0, col0, nr, nc, ring;
     std::int32_t made = 0;  // rows [0, made) were made; the ring holds the last `ring` of them
+
+    void columns(std::int32_t first, std::int32_t rows, size_t at, std::int32_t c0, std::int32_t c1) {
+        if (c0 >= c1) return;
+        const int J = f.joints, width = 2 * J;
+        const std::int32_t n = c1 - c0;
+        const size_t ucols = static_cast<size_t>(nc), out = at + static_cast<size_t>(c0);
+        row_dots(f.xz.data(), row0 + first, rows, f.xz.data(), col0 + c0, n, width, b.ca + out, nc);
+        row_dots(f.xz.data(), row0 + first, rows, f.zx.data(), col0 + c0, n, width, b.cb + out, nc);
+        row_dots(f.y.data(), row0 + first, rows, f.y.data(), col0 + c0, n, J, b.cy + out, nc);
+        if (o.product_noise > 0.0) {
+            perturb_products(b.ca + out, ucols, row0 + first, rows, col0 + c0, n, o.product_noise * bound.product_xz, 0);
+            perturb_products(b.cb + out, ucols, row0 + first, rows, col0 + c0, n, o.product_noise * bound.product_xz, 1);
+            perturb_products(b.cy + out, ucols, row0 + first, rows, col0 + c0, n, o.product_noise * bound.product_y, 2);
+        }
+    }
     // Rows up to `last` (r + k − 1 for row r, which reads product rows r − 1 … r + k − 1): a band
     // starts at made ≤ last and overwrites rows up to made − ring + kBand − 1 ≤ last − k − 1 = r − 2.
-    const auto products_through = [&](std::int32_t last) {
+    void through(std::int32_t last) {
         while (made <= last) {
             const std::int32_t slot = made % ring, rows = std::min({kBand, nr - made, ring - slot});
-            const size_t at = static_cast<size_t>(slot) * ucols;
-            row_dots(f.xz.data(), row0 + made, rows, f.xz.data(), col0, nc, width, s.ca.data() + at);
-            row_dots(f.xz.data(), row0 + made, rows, f.zx.data(), col0, nc, width, s.cb.data() + at);
-            row_dots(f.y.data(), row0 + made, rows, f.y.data(), col0, nc, J, s.cy.data() + at);
-            if (o.product_noise > 0.0) {
-                perturb_products(s.ca.data() + at, row0 + made, rows, col0, nc, o.product_noise * bound.product_xz, 0);
-                perturb_products(s.cb.data() + at, row0 + made, rows, col0, nc, o.product_noise * bound.product_xz, 1);
-                perturb_products(s.cy.data() + at, row0 + made, rows, col0, nc, o.product_noise * bound.product_y, 2);
+            const size_t at = static_cast<size_t>(slot) * static_cast<size_t>(nc);
+            const std::int32_t skip_end = made + mirror.delta;  // the band's first row's first diagonal column
+            if (made + rows > mirror.partial_rows || skip_end <= mirror.strip_products) {
+                columns(made, rows, at, 0, nc);
+            } else {
+                columns(made, rows, at, 0, mirror.strip_products);
+                columns(made, rows, at, std::min(skip_end, nc), nc);
             }
             made += rows;
         }
-    };
+    }
+};
 
-    const std::int32_t dr = ei1 - ei0, dc = ej1 - ej0;
-    s.row_cx.assign(f.cx.begin() + row0, f.cx.begin() + row0 + nr);
-    s.row_cz.assign(f.cz.begin() + row0, f.cz.begin() + row0 + nr);
-    s.col_cx.assign(f.cx.begin() + col0, f.cx.begin() + col0 + nc);
-    s.col_cz.assign(f.cz.begin() + col0, f.cz.begin() + col0 + nc);
-    const TileTerms terms{s.ca.data(), s.cb.data(), s.cy.data(), s.row_cx.data(), s.row_cz.data(),
-                          s.col_cx.data(), s.col_cz.data(), ucols, static_cast<size_t>(ring)};
-
-    // Per column: window B's spread and W/k · Σ centroid; columns whose window leaves its clip.
+// Per column of a box: window B's spread and W/k · Σ centroid; columns whose window leaves its clip.
+void column_windows(const FrameFeatures& f, std::int32_t ej0, std::int32_t dc, TileScratch& s) {
+    const std::int32_t k = f.window, col0 = ej0 - k + 1;
     const size_t udc = static_cast<size_t>(dc);
     s.col_spread.resize(udc);
     s.col_x.resize(udc);
@@ -708,27 +783,58 @@ void fill_region(const FrameFeatures& f, const CandidateSearchOptions& o, const 
         s.col_z[static_cast<size_t>(c)] = w_over_k * f.window_cz[g];
         if (!f.end_ok[static_cast<size_t>(ej0 + c)]) s.invalid_cols.push_back(c);
     }
+}
+
+// The bounds [lo, hi] of every pair i ∈ [ei0, ei1), j ∈ [ej0, ej1) (valid: i < N − k + 1,
+// j ≥ k − 1) into s.buffers.box_lo / box_hi, rows ej1 − ej0 apart: three dgemm products of
+// the frames, the window sums slid along the diagonals, the distances in double.
+// `symmetric`: the box's rows and columns are the same windows (BoxMirror): about half
+// of it is computed, the rest copied.
+void fill_region(const FrameFeatures& f, const CandidateSearchOptions& o, const DistanceErrorBound& bound,
+                 std::int32_t ei0, std::int32_t ei1, std::int32_t ej0, std::int32_t ej1, bool symmetric, TileScratch& s) {
+    const std::int32_t k = f.window;
+    const std::int32_t nr = ei1 - ei0 + k - 1, nc = ej1 - ej0 + k - 1;
+    const std::int32_t row0 = ei0, col0 = ej0 - k + 1;
+    const std::int32_t ring = std::min(nr, kBand + k);
+    const size_t ucols = static_cast<size_t>(nc);
+    const std::int32_t dr = ei1 - ei0, dc = ej1 - ej0;
+    const size_t udc = static_cast<size_t>(dc);
+    s.buffers.ensure(static_cast<size_t>(ring) * ucols, static_cast<size_t>(dr) * udc);
+    TileBuffers& b = s.buffers;
+    const BoxMirror mirror = box_mirror(symmetric, ei0 - col0, dr, dc, k);
+    ProductRing products{f, o, bound, mirror, b, row0, col0, nr, nc, ring};
+
+    s.row_cx.assign(f.cx.begin() + row0, f.cx.begin() + row0 + nr);
+    s.row_cz.assign(f.cz.begin() + row0, f.cz.begin() + row0 + nr);
+    s.col_cx.assign(f.cx.begin() + col0, f.cx.begin() + col0 + nc);
+    s.col_cz.assign(f.cz.begin() + col0, f.cz.begin() + col0 + nc);
+    const TileTerms terms{b.ca, b.cb, b.cy, s.row_cx.data(), s.row_cz.data(),
+                          s.col_cx.data(), s.col_cz.data(), ucols, static_cast<size_t>(ring)};
+    column_windows(f, ej0, dc, s);
     // Window sums row by row: row 0 and column 0 directly, the rest by sliding along
-    // the diagonals (two double adds per sum and pair instead of k).
-    s.box_lo.ensure(static_cast<size_t>(dr) * udc);
-    s.box_hi.ensure(static_cast<size_t>(dr) * udc);
+    // the diagonals (two double adds per sum and pair instead of k). A mirrored box's first
+    // row without a gap after rows with one is summed directly too (its gap's diagonals
+    // were not slid).
     s.sums[0].resize(kSumCount * udc);
     s.sums[1].resize(kSumCount * udc);
     const double inv_wk = 1.0 / (f.weight * k);
     for (std::int32_t r = 0; r < dr; ++r) {
         double* cur = s.sums[static_cast<size_t>(r & 1)].data();
         const double* prev = s.sums[static_cast<size_t>((r + 1) & 1)].data();
-        products_through(r + k - 1);  // row r's windows end on product row r + k − 1
-        if (r == 0) {
-            for (std::int32_t c = 0; c < dc; ++c) direct_window_sums(terms, 0, c, k, dc, cur);
+        products.through(r + k - 1);  // row r's windows end on product row r + k − 1
+        const std::int32_t gb = mirror.gap_begin(r), ge = mirror.gap_end(r);  // columns [gb, ge) not computed
+        if (r == 0 || (r == mirror.partial_rows && r > 0)) {
+            for (std::int32_t c = 0; c < dc; ++c)
+                if (c < gb || c >= ge) direct_window_sums(terms, r, c, k, dc, cur);
         } else {
-            direct_window_sums(terms, r, 0, k, dc, cur);
-            slide_window_sums(terms, r, k, dc, prev, cur);
+            if (gb > 0 || ge == 0) direct_window_sums(terms, r, 0, k, dc, cur);
+            slide_window_sums(terms, r, k, dc, 1, std::max(gb, 1), prev, cur);
+            slide_window_sums(terms, r, k, dc, std::max(ge, 1), dc, prev, cur);
         }
         const std::int32_t i = ei0 + r;
         const size_t ui = static_cast<size_t>(i);
-        float* __restrict lo = s.box_lo.data() + static_cast<size_t>(r) * udc;
-        float* __restrict hi = s.box_hi.data() + static_cast<size_t>(r) * udc;
+        float* __restrict lo = b.box_lo + static_cast<size_t>(r) * udc;
+        float* __restrict hi = b.box_hi + static_cast<size_t>(r) * udc;
         if (!f.start_ok[ui]) {
             std::fill(lo, lo + dc, kPairInvalid);
             std::fill(hi, hi + dc, kPairInvalid);
@@ -736,15 +842,22 @@ void fill_region(const FrameFeatures& f, const CandidateSearchOptions& o, const 
         }
         // Branch-free over the row (it vectorises); invalid and near-diagonal pairs
         // are patched afterwards from short lists (their status is exact).
-        window_distances(cur, dc, RowWindow{f.window_spread[ui], f.window_cx[ui], f.window_cz[ui]}, f.weight, inv_wk,
-                         bound.distance, s.col_spread.data(), s.col_x.data(), s.col_z.data(), lo, hi);
-        for (const std::int32_t c : s.invalid_cols) lo[c] = hi[c] = kPairInvalid;
+        const RowWindow window{f.window_spread[ui], f.window_cx[ui], f.window_cz[ui]};
+        for (const auto& [c0, c1] : {std::pair{0, std::min(gb, dc)}, std::pair{std::max(ge, gb), dc}}) {
+            if (c0 >= c1) continue;
+            const size_t u0 = static_cast<size_t>(c0);
+            window_distances(cur + u0, udc, static_cast<size_t>(c1 - c0), window, f.weight, inv_wk, bound.distance,
+                             s.col_spread.data() + u0, s.col_x.data() + u0, s.col_z.data() + u0, lo + u0, hi + u0);
+        }
+        for (const std::int32_t c : s.invalid_cols) lo[c] = hi[c] = kPairInvalid;  // (gap cells: copied over below)
         // Same clip and windows starting at most k frames apart: g ∈ [i − k, i + k].
         const std::int32_t c_lo = std::max(i - k - col0, 0), c_hi = std::min(i + k - col0, dc - 1);
         for (std::int32_t c = c_lo; c <= c_hi; ++c)
-            if (f.clip_of[static_cast<size_t>(col0 + c)] == f.clip_of[ui] && lo[c] != kPairInvalid)
+            if ((c < gb || c >= ge) && f.clip_of[static_cast<size_t>(col0 + c)] == f.clip_of[ui] && lo[c] != kPairInvalid)
                 lo[c] = hi[c] = kPairExcluded;
     }
+    copy_mirrored(mirror, udc, b.box_lo);
+    copy_mirrored(mirror, udc, b.box_hi);
 }
 
 // Tiles (a, b) and (b, a) from one computed box. The window distance is symmetric: pair
@@ -767,20 +880,20 @@ void run_tile_pair(const FrameFeatures& f, const CandidateSearchOptions& o, cons
         r0 = std::min(r0, q.ej0 - k + 1), r1 = std::max(r1, q.ej1 - k + 1);
         c0 = std::min(c0, q.ei0 + k - 1), c1 = std::max(c1, q.ei1 + k - 1);
     }
-    fill_region(f, o, bound, r0, r1, c0, c1, s);
+    fill_region(f, o, bound, r0, r1, c0, c1, a == b, s);
     const size_t stride = static_cast<size_t>(c1 - c0);
     if (!p.empty()) {
         const size_t at = static_cast<size_t>(p.ei0 - r0) * stride + static_cast<size_t>(p.ej0 - c0);
-        p.lo = s.box_lo.data() + at, p.lo_i_step = stride, p.lo_j_step = 1;
-        p.hi = s.box_hi.data() + at, p.hi_i_step = stride, p.hi_j_step = 1;
+        p.lo = s.buffers.box_lo + at, p.lo_i_step = stride, p.lo_j_step = 1;
+        p.hi = s.buffers.box_hi + at, p.hi_i_step = stride, p.hi_j_step = 1;
         decide_tile_minima(f, o, p, s);
     }
     if (q.empty()) return;
     // q[r][c] = box[c + q.ej0 − k + 1 − r0][r + q.ei0 + k − 1 − c0]: both bounds read in place,
     // transposed (decide_tile_minima scans such a tile along the box's rows).
     const size_t br = static_cast<size_t>(q.ej0 - k + 1 - r0), bc = static_cast<size_t>(q.ei0 + k - 1 - c0);
-    q.lo = s.box_lo.data() + br * stride + bc, q.lo_i_step = 1, q.lo_j_step = stride;
-    q.hi = s.box_hi.data() + br * stride + bc, q.hi_i_step = 1, q.hi_j_step = stride;
+    q.lo = s.buffers.box_lo + br * stride + bc, q.lo_i_step = 1, q.lo_j_step = stride;
+    q.hi = s.buffers.box_hi + br * stride + bc, q.hi_i_step = 1, q.hi_j_step = stride;
     decide_tile_minima(f, o, q, s);
 }
 
@@ -805,8 +918,7 @@ CandidateSearchResult find_transition_candidates(const FrameFeatures& f, const C
         const size_t frames = side + static_cast<size_t>(f.window) - 1;
         const size_t ring = std::min(frames, static_cast<size_t>(kBand + f.window));
         for (TileScratch& s : scratch) {
-            s.ca.ensure(ring * frames), s.cb.ensure(ring * frames), s.cy.ensure(ring * frames);
-            s.box_lo.ensure(side * side), s.box_hi.ensure(side * side);
+            s.buffers.ensure(ring * frames, side * side);
         }
     }
     if (o.plot)
