@@ -398,7 +398,7 @@ TEST_CASE("gait sweep regressions: seed 2's cases fixed by the gait3 and gait4 c
 // main): 1-0062 2976, 1-0091 1817, 1-0265 2693, 2-0227 3161, 7-0220 2708,
 // 7-0495 1782, 7-0512 3696, 7-0564 3147, 7-0680 2032, 7-0684 2247, 7-0797 2607,
 // 7-0918 3146, 7-0950 2909, 7-0956 1557.
-TEST_CASE("gait sweep regressions: a stranded swing re-aims once, not every tick; no foot in a tread", "[gait_sweep]") {
+TEST_CASE("gait sweep regressions: a stranded swing does not re-aim every tick and no foot enters a tread", "[gait_sweep]") {
     const SimConfig& config = shipped_config();
     for (const SweepRegression r : {SweepRegression{2, 52}, SweepRegression{7, 655}}) {
         const SweepCase c = generate_sweep_case(r.seed, r.index, config);
