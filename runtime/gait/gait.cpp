@@ -883,21 +883,31 @@ Placement aim_swing(const GaitState& g, const GaitTick& t, vec3 root, int i, flo
 // f.path_travel is swing_travel(f, rig), computed once at the swing's start.
 float shortest_swing(const FootState& f) { return maxf(kShortestSwing, f.path_travel / kMaxMeanSwingSpeed); }
 
-// Starts (or re-aims) foot i's phase-driven swing at its phase psi, aimed for
-// the time it will take. A swing held to its travel at kMaxMeanSwingSpeed
-// outlasts the phase left when an ordinary swing already moves near 4 m/s (a
-// run near 1.9 m/s): aimed for the phase's time, it landed behind the root, was
-// flagged stranded and re-aimed over and over (the spun-stick test's case 27,
-// foot_l 5,358 °/s). It is aimed again for its own, longer time then.
-void begin_aimed_swing(GaitState& g, const GaitTick& t, vec3 root, int i, float psi) {
-    FootState& f = g.feet[static_cast<std::size_t>(i)];
+// Where foot i's phase-driven swing starting (or re-aiming) now at its phase
+// psi lands: aimed for the time it will take. A swing held to its travel at
+// kMaxMeanSwingSpeed outlasts the phase left when an ordinary swing already
+// moves near 4 m/s (a run near 1.9 m/s): aimed for the phase's time, it landed
+// behind the root, was flagged stranded and re-aimed over and over (the
+// spun-stick test's case 27, foot_l 5,358 °/s). It is aimed again for its own,
+// longer time then.
+Placement aimed_target(const GaitState& g, const GaitTick& t, vec3 root, int i, float psi) {
     const float remaining = 1.0f - psi;
-    begin_swing(f, aim_swing(g, t, root, i, remaining), t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
-    if (!(t.dphase > 0.0f)) return;
+    const Placement first = aim_swing(g, t, root, i, remaining);
+    if (!(t.dphase > 0.0f)) return first;
+    FootState trial = g.feet[static_cast<std::size_t>(i)];
+    trial.start = trial.ankle;
+    trial.start_rotation = trial.rotation;
+    trial.target = first.ankle;
+    trial.target_rotation = first.rotation;
     const float phase_time = maxf(kMinSwingPhaseShare, remaining) * t.dt / t.dphase;
-    const float swing_time = shortest_swing(f);
-    if (swing_time > phase_time)
-        begin_swing(f, aim_swing(g, t, root, i, swing_time * t.dphase / t.dt), t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
+    // trial is not built (no path_travel yet): its travel from its start and target.
+    const float swing_time = maxf(kShortestSwing, swing_travel(trial, t.rig) / kMaxMeanSwingSpeed);
+    return swing_time > phase_time ? aim_swing(g, t, root, i, swing_time * t.dphase / t.dt) : first;
+}
+
+// Starts (or re-aims) foot i's phase-driven swing at its phase psi toward aimed_target.
+void begin_aimed_swing(GaitState& g, const GaitTick& t, int i, float psi, const Placement& target) {
+    begin_swing(g.feet[static_cast<std::size_t>(i)], target, t.terrain, t.rig, t.c, g.run_blend, psi, 0.0f);
 }
 
 // The foot's phase for a re-aim. A swing that outlasts its phase (held to its
@@ -944,11 +954,19 @@ void reaim_if_command_changed(GaitState& g, const GaitTick& t, vec3 root, int i)
         stepping && ((command_changed && f.replanned < kMaxReaims && f.progress < kLatestReaimProgress) || stranded);
     if (!may_reaim) return;
     const float psi = swing_phase_now(f, g.cycle_phase, i);
-    const Placement p = aim_swing(g, t, root, i, 1.0f - psi);
-    const bool closer = !stranded || horizontal_distance(p.ankle, hip_then) < gap - kMinReaimShiftM;
-    if (closer && horizontal_distance(p.ankle, f.target) > kMinReaimShiftM) {
+    // A stranded swing is judged by the spot it would really be re-aimed at
+    // (aimed_target: for the time the swing will take). Judged by the phase's
+    // spot while the longer time's spot was taken, a stranded swing on a
+    // turning path re-aimed every tick to about the spot it had, its progress
+    // held at 0 for up to 140 ticks while the pelvis sank to reach the spot
+    // and the lifting foot was pulled into the tread behind it (sweep cases
+    // 2-0052, 104 mm, and 7-0655, 15.7 mm, walking down and up stairs with the
+    // stick circling). A command change is still judged by the phase's spot.
+    const Placement aimed = stranded ? aimed_target(g, t, root, i, psi) : aim_swing(g, t, root, i, 1.0f - psi);
+    const bool closer = !stranded || horizontal_distance(aimed.ankle, hip_then) < gap - kMinReaimShiftM;
+    if (closer && horizontal_distance(aimed.ankle, f.target) > kMinReaimShiftM) {
         const float ground = f.ground;
-        begin_aimed_swing(g, t, root, i, psi);
+        begin_aimed_swing(g, t, i, psi, stranded ? aimed : aimed_target(g, t, root, i, psi));
         f.start_ground = ground;
         ++f.replanned;
     }
@@ -990,7 +1008,7 @@ void lift_if_due(GaitState& g, const GaitTick& t, vec3 root, int i) {
     const bool left_behind = !other.swinging && psi >= t.plan.duty - kEarlyLiftPhase &&
                              (behind > kEarlyLiftReachShare * t.rig.leg_reach || behind > kEarlyLiftStanceShare * kStanceReachM);
     if ((psi >= t.plan.duty && (!walking || !other.swinging)) || left_behind) {
-        begin_aimed_swing(g, t, root, i, psi);
+        begin_aimed_swing(g, t, i, psi, aimed_target(g, t, root, i, psi));
         f.planned_speed = g.commanded_speed;
         f.planned_heading = t.desired_heading;
         evaluate_swing(f, i, t.c, t.rig, g.run_blend, t.h.left);

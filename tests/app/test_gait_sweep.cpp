@@ -387,6 +387,38 @@ TEST_CASE("gait sweep regressions: seed 2's cases fixed by the gait3 and gait4 c
     }
 }
 
+// A stranded swing is judged by the spot it would really be re-aimed at (the
+// one aimed for the time the swing will take, branch gait9). Judged by the
+// phase's spot, a swing on a turning path re-aimed every tick to about the spot
+// it already had, its progress held at 0 for up to 140 ticks while the pelvis
+// sank to reach it, and the lifting foot was pulled into the tread behind it:
+// 2-0052 (walking down 11.5 cm stairs, the stick circling) 103.7 mm and
+// 3,681 °/s, 7-0655 (up 22 cm / 28 cm stairs) 15.7 mm and 2,812 °/s on main
+// fd8f33e. The same loop broke the joint-speed limit in the other cases (°/s on
+// main): 1-0062 2976, 1-0091 1817, 1-0265 2693, 2-0227 3161, 7-0220 2708,
+// 7-0495 1782, 7-0512 3696, 7-0564 3147, 7-0680 2032, 7-0684 2247, 7-0797 2607,
+// 7-0918 3146, 7-0950 2909, 7-0956 1557.
+TEST_CASE("gait sweep regressions: a stranded swing does not re-aim every tick and no foot enters a tread", "[gait_sweep]") {
+    const SimConfig& config = shipped_config();
+    for (const SweepRegression r : {SweepRegression{2, 52}, SweepRegression{7, 655}}) {
+        const SweepCase c = generate_sweep_case(r.seed, r.index, config);
+        const SweepCaseResult result = evaluate_sweep_case(c, config);
+        INFO(c.id << ": " << c.description << ": " << result.problem);
+        CHECK(result.metrics.penetration_mm < kMaxPenetrationMm);
+        CHECK(result.problem.empty());
+    }
+    for (const SweepRegression r : {SweepRegression{1, 62}, SweepRegression{1, 91}, SweepRegression{1, 265},
+                                    SweepRegression{2, 227}, SweepRegression{7, 220}, SweepRegression{7, 495},
+                                    SweepRegression{7, 512}, SweepRegression{7, 564}, SweepRegression{7, 680},
+                                    SweepRegression{7, 684}, SweepRegression{7, 797}, SweepRegression{7, 918},
+                                    SweepRegression{7, 950}, SweepRegression{7, 956}}) {
+        const SweepCase c = generate_sweep_case(r.seed, r.index, config);
+        const SweepCaseResult result = evaluate_sweep_case(c, config);
+        INFO(c.id << ": " << c.description << ": " << result.problem);
+        CHECK(result.problem.empty());
+    }
+}
+
 // Known failure, kept so it stays found (docs/gait.md, "Branch gait4"): 1-0039
 // (1,529 °/s, shin_l, a 29 cm curb, circles and a step turn). Not fixed yet,
 // so it may fail.
