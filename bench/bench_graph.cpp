@@ -136,6 +136,28 @@ void BM_BuildSynthetic(benchmark::State& state) {
     }
 }
 
+// The subset BM_ReferenceSpeedup and BM_TiledSearch search: a synthetic database
+// of `frames` frames, its features, and one-thread search options at its 5th
+// percentile distance.
+struct SubsetSearch {
+    ClipDatabase db;
+    double leg;
+    std::vector<vec3> p;
+    FrameFeatures f;
+    CandidateSearchOptions o;
+};
+
+SubsetSearch subset_search(std::int64_t frames) {
+    SubsetSearch s{synthetic(frames), 0.0, {}, {}, {}};
+    s.leg = skeleton_leg_length(s.db.skeleton, s.db.left_foot);
+    s.p = database_positions(s.db);
+    s.f = compute_frame_features(s.db, s.p, 10, s.leg);
+    s.o.neighbourhood = 4;
+    s.o.threshold = distance_percentiles(s.f, {5.0})[0];
+    s.o.threads = 1;
+    return s;
+}
+
 // The straightforward reference (per pair, per window frame, per joint) against
 // the tiled search on a subset, both on one thread. The tiled search's time is the
 // median of five complete calls (each allocating its buffers afresh), the
@@ -144,14 +166,12 @@ void BM_BuildSynthetic(benchmark::State& state) {
 // speed-up grows as the tiled search's fixed costs are spread (the reference's
 // time grows with the pairs: ~2, 8 and 18 s of CPU).
 void BM_ReferenceSpeedup(benchmark::State& state) {
-    const ClipDatabase db = synthetic(static_cast<std::int64_t>(state.range(0)));
-    const double leg = skeleton_leg_length(db.skeleton, db.left_foot);
-    const std::vector<vec3> p = database_positions(db);
-    const FrameFeatures f = compute_frame_features(db, p, 10, leg);
-    CandidateSearchOptions o;
-    o.neighbourhood = 4;
-    o.threshold = distance_percentiles(f, {5.0})[0];
-    o.threads = 1;
+    const SubsetSearch subset = subset_search(static_cast<std::int64_t>(state.range(0)));
+    const ClipDatabase& db = subset.db;
+    const double leg = subset.leg;
+    const std::vector<vec3>& p = subset.p;
+    const FrameFeatures& f = subset.f;
+    const CandidateSearchOptions& o = subset.o;
     for (auto _ : state) {
         std::vector<double> cpu, wall;
         CandidateSearchResult tiled;
@@ -203,16 +223,9 @@ void BM_ReferenceSpeedup(benchmark::State& state) {
 // driver to profile (`perf record` with --benchmark_filter=TiledSearch). Each call
 // allocates its buffers afresh, as a build does.
 void BM_TiledSearch(benchmark::State& state) {
-    const ClipDatabase db = synthetic(static_cast<std::int64_t>(state.range(0)));
-    const double leg = skeleton_leg_length(db.skeleton, db.left_foot);
-    const std::vector<vec3> p = database_positions(db);
-    const FrameFeatures f = compute_frame_features(db, p, 10, leg);
-    CandidateSearchOptions o;
-    o.neighbourhood = 4;
-    o.threshold = distance_percentiles(f, {5.0})[0];
-    o.threads = 1;
+    const SubsetSearch subset = subset_search(static_cast<std::int64_t>(state.range(0)));
     std::size_t candidates = 0;
-    for (auto _ : state) candidates = find_transition_candidates(f, o).candidates.size();
+    for (auto _ : state) candidates = find_transition_candidates(subset.f, subset.o).candidates.size();
     state.counters["candidates"] = static_cast<double>(candidates);
 }
 
