@@ -880,8 +880,9 @@ Placement aim_swing(const GaitState& g, const GaitTick& t, vec3 root, int i, flo
 // at kMaxMeanSwingSpeed. A foot lifting (or re-aimed) late in its phase had the
 // cycle's few remaining hundredths of a second for up to 0.9 m: its shin passed
 // 1500 °/s (wall × reversals after a long stop swing, 1506 °/s).
+float shortest_swing_for(float travel) { return maxf(kShortestSwing, travel / kMaxMeanSwingSpeed); }
 // f.path_travel is swing_travel(f, rig), computed once at the swing's start.
-float shortest_swing(const FootState& f) { return maxf(kShortestSwing, f.path_travel / kMaxMeanSwingSpeed); }
+float shortest_swing(const FootState& f) { return shortest_swing_for(f.path_travel); }
 
 // Where foot i's phase-driven swing starting (or re-aiming) now at its phase
 // psi lands: aimed for the time it will take. A swing held to its travel at
@@ -901,7 +902,7 @@ Placement aimed_target(const GaitState& g, const GaitTick& t, vec3 root, int i, 
     trial.target_rotation = first.rotation;
     const float phase_time = maxf(kMinSwingPhaseShare, remaining) * t.dt / t.dphase;
     // trial is not built (no path_travel yet): its travel from its start and target.
-    const float swing_time = maxf(kShortestSwing, swing_travel(trial, t.rig) / kMaxMeanSwingSpeed);
+    const float swing_time = shortest_swing_for(swing_travel(trial, t.rig));
     return swing_time > phase_time ? aim_swing(g, t, root, i, swing_time * t.dphase / t.dt) : first;
 }
 
