@@ -135,38 +135,77 @@ float FootPlacementJob::foot_depth(const FootPlacementLeg& leg, vec3 shift) cons
 bool FootPlacementJob::lift_feet_above_ground(vec3 forward) const {
     bool moved = false;
     for (const FootPlacementLeg& leg : rig->legs) {
-        const float depth = smooth_feet ? smooth_lift(state->feet[static_cast<size_t>(&leg - rig->legs.data())], leg)
-                                        : foot_depth(leg, vec3(0.0f));
-        if (!(depth > 0.0f)) continue;
+        const vec3 shift = smooth_feet ? smooth_lift(state->feet[static_cast<size_t>(&leg - rig->legs.data())], leg)
+                                       : vec3(0.0f, foot_depth(leg, vec3(0.0f)), 0.0f);
+        if (!(shift.y > 0.0f) && shift.x == 0.0f && shift.z == 0.0f) continue;
         const size_t ankle = static_cast<size_t>(leg.ankle);
-        solve_leg(leg, pose.model_positions[ankle] + vec3(0.0f, depth, 0.0f), pose.model_rotations[ankle], forward);
+        const vec3 lift(shift.x, shift.y > 0.0f ? shift.y : 0.0f, shift.z);
+        solve_leg(leg, pose.model_positions[ankle] + lift, pose.model_rotations[ankle], forward);
         moved = true;
     }
     return moved;
 }
 
-// smooth_feet's lift of one foot (m, ≥ 0): a spring toward the deepest the
-// foot is now or will be within kLiftLookAheadS at its current velocity, held
-// at least at the depth it is at now.
-float FootPlacementJob::smooth_lift(FootPin& pin, const FootPlacementLeg& leg) const {
+// smooth_feet's lift and hold of one free foot: the shift (m) its ankle is
+// moved by, a horizontal hold-back plus a lift ≥ 0.
+//   The lift is a spring toward the deepest the foot is now or will be within
+//   kLiftLookAheadS, moving at its current horizontal velocity (not its
+//   vertical one: the foot's own ground easing up must not hide a riser ahead).
+//   The hold: where the lift has not yet reached the depth the foot would be at
+//   now (its toes would cross into a riser), the foot is held back along the
+//   way it came, as little as keeps it out of the riser plus kHoldMarginM, and
+//   the held-back offset then decays (critically damped, kHoldHalflifeS) so the
+//   foot catches up with the clip's once the lift clears the step. Only where
+//   even last tick's place is too deep does the lift snap to the depth (the
+//   floor, so no point penetrates). A pinned foot is never held back.
+vec3 FootPlacementJob::smooth_lift(FootPin& pin, const FootPlacementLeg& leg) const {
     const vec3 a = pose.model_positions[static_cast<size_t>(leg.ankle)];
     const bool advance = state->started && dt > 0.0f;
-    const vec3 velocity = advance ? (a - pin.unlifted_previous) / dt : vec3(0.0f);
-    pin.unlifted_previous = a;
-    const float now = foot_depth(leg, vec3(0.0f));
+    const bool free = state->started && pin.contact != 1;
+    const vec3 clip_previous = pin.unlifted_previous - pin.hold_offset;  // the clip's ankle last tick
+    const vec3 previous = pin.unlifted_previous;                         // where the ankle was put last tick, before the lift
+    if (!free) pin.hold_offset = pin.hold_velocity = vec3(0.0f);
+    else if (advance) {
+        damp_toward(pin.hold_offset.x, pin.hold_velocity.x, 0.0f, kHoldHalflifeS, dt);
+        damp_toward(pin.hold_offset.z, pin.hold_velocity.z, 0.0f, kHoldHalflifeS, dt);
+    }
+    vec3 velocity = advance ? (a + pin.hold_offset - previous) / dt : vec3(0.0f);
+    velocity.y = 0.0f;
+    float now = foot_depth(leg, pin.hold_offset);
     float goal = now > 0.0f ? now : 0.0f;
     for (int k = 1; k <= 3; ++k) {
-        const float ahead = foot_depth(leg, velocity * (kLiftLookAheadS * static_cast<float>(k) / 3.0f));
+        const float ahead = foot_depth(leg, pin.hold_offset + velocity * (kLiftLookAheadS * static_cast<float>(k) / 3.0f));
         goal = ahead > goal ? ahead : goal;
     }
     if (!state->started) pin.lift = goal, pin.lift_velocity = 0.0f;
     else if (advance) damp_toward(pin.lift, pin.lift_velocity, goal, kLiftHalflifeS, dt);
+    if (free && advance && pin.lift < now) {
+        vec3 back = previous - (a + pin.hold_offset);
+        back.y = 0.0f;
+        if (foot_depth(leg, pin.hold_offset + back) <= pin.lift) {
+            // Bisect for the least fraction of the way back that keeps the foot
+            // out (the depth along it is a step function: a riser's edge).
+            float inside = 0.0f, outside = 1.0f;
+            for (int it = 0; it < 12; ++it) {
+                const float mid = 0.5f * (inside + outside);
+                if (foot_depth(leg, pin.hold_offset + back * mid) <= pin.lift) outside = mid;
+                else inside = mid;
+            }
+            const float span = std::sqrt(back.x * back.x + back.z * back.z);
+            const float fraction = span > kHoldMarginM ? outside + kHoldMarginM / span : 1.0f;
+            pin.hold_offset += back * (fraction < 1.0f ? fraction : 1.0f);
+            // Held, the foot is at rest: the offset's rate cancels the clip ankle's.
+            pin.hold_velocity = vec3(-(a.x - clip_previous.x) / dt, 0.0f, -(a.z - clip_previous.z) / dt);
+            now = foot_depth(leg, pin.hold_offset);
+        }
+    }
     const float floor = now > 0.0f ? now : 0.0f;
     if (pin.lift < floor) {
         pin.lift = floor;
         if (pin.lift_velocity < 0.0f) pin.lift_velocity = 0.0f;
     }
-    return pin.lift;
+    pin.unlifted_previous = a + pin.hold_offset;
+    return pin.hold_offset + vec3(0.0f, pin.lift, 0.0f);
 }
 
 // smooth_feet's ankle target: the pin while pinned; else the clip's ankle plus
@@ -248,8 +287,15 @@ bool FootPlacementJob::run() const {
                                                  a.z + moved.z / step * kFootLookAheadM, 0.05f);
             wanted = ahead > wanted ? ahead : wanted;
         }
-        if (!s.started || pin.contact == 1) pin.ground = sample[i].height;
-        else {
+        if (!s.started || pin.contact == 1) {
+            pin.ground = sample[i].height;
+            pin.ground_velocity = 0.0f;
+        } else if (smooth_feet) {
+            // A spring, not the rate limit: the foot's ground starts and stops
+            // moving smoothly (the limit's 0 → 3 m/s in one tick turned the knee
+            // up to 2,113 °/s); a riser it has not risen to in time is the hold's.
+            if (dt > 0.0f) damp_toward(pin.ground, pin.ground_velocity, wanted, kFootGroundHalflifeS, dt);
+        } else {
             const float limit = kFootGroundSpeed * dt;
             const float change = wanted - pin.ground;
             pin.ground += change > limit ? limit : (change < -limit ? -limit : change);

@@ -8,7 +8,7 @@
 //     kPinMaxSpeed, is pinned where it touched down and held there by the two-bone
 //     IK until the clip lifts it; then it eases back to the clip's own path;
 //   - a foot is placed on its own ground height, which eases (at most
-//     kFootGroundSpeed) toward the highest ground under it and up to
+//     kFootGroundSpeed; smooth_feet: a spring) toward the highest ground under it and up to
 //     kFootLookAheadM ahead of it, so a foot rises onto a step before its toes
 //     reach the riser, not at it;
 //   - a planted foot tilts to the ground's normal.
@@ -41,6 +41,9 @@ struct FootPin {
     vec3 unlifted_previous{0.0f};// the ankle last tick before the lift: the foot's velocity for the look-ahead
     float lift = 0.0f;           // metres the foot is raised above its placement, ≥ the depth it would penetrate
     float lift_velocity = 0.0f;  // its rate (m/s)
+    float ground_velocity = 0.0f;// the rate (m/s) of `ground` while free: its critically damped spring
+    vec3 hold_offset{0.0f};      // horizontal: a free foot held back from a riser its lift has not cleared, decaying to 0
+    vec3 hold_velocity{0.0f};    // its rate (m/s)
     vec3 tilt_normal{0.0f, 1.0f, 0.0f};  // the ground normal the foot tilts to, following the one under it (critically damped)
     vec3 tilt_normal_velocity{0.0f};     // its rate (1/s)
 };
@@ -91,6 +94,14 @@ inline constexpr float kFootLookAheadM = 0.35f;
 // and the lift spring's halflife (s).
 inline constexpr float kLiftLookAheadS = 0.1f;
 inline constexpr float kLiftHalflifeS = 0.04f;
+// smooth_feet's ground: the halflife (s) of the spring that carries a free
+// foot's ground height toward the highest ground under and ahead of it (graph_feet
+// keeps the kFootGroundSpeed rate limit).
+inline constexpr float kFootGroundHalflifeS = 0.05f;
+// smooth_feet's hold: a free foot whose lift has not cleared a riser is held back
+// this far (m) short of it, and the hold-back then decays with this halflife (s).
+inline constexpr float kHoldMarginM = 0.01f;
+inline constexpr float kHoldHalflifeS = 0.05f;
 // smooth_feet's tilt: halflife (s) of the spring that carries the normal a foot
 // tilts to toward the ground's normal under it. The terrain's normal is
 // discontinuous where a slope meets the flat (a crease): read at one point, a
@@ -128,8 +139,11 @@ struct FootPlacementJob {
     // as it was, then the offset decays critically damped, halflife
     // release_s / 3) instead of a smoothstep lerp; and keep_above_ground's lift
     // is a critically damped spring toward the deepest the foot will be within
-    // kLiftLookAheadS at its current velocity (rising before a riser is reached,
-    // falling smoothly after), never below the depth it is at now; and the
+    // kLiftLookAheadS at its current horizontal velocity (rising before a riser
+    // is reached, falling smoothly after), never below the depth it is at now,
+    // and a free foot the lift has not raised in time is held back short of the
+    // riser (kHoldMarginM) instead of snapping up; and a free foot's ground
+    // follows a spring (kFootGroundHalflifeS), not the 3 m/s limit; and the
     // two-bone IK bends the knee toward the thigh's +Z, not toward the clip's knee;
     // and the ground normal a foot tilts to follows the one under it through a
     // critically damped spring (kTiltHalflifeS), so a crease does not snap it.
@@ -146,7 +160,7 @@ private:
     vec3 thigh_pole(const FootPlacementLeg& leg, vec3 forward) const;
     float foot_depth(const FootPlacementLeg& leg, vec3 shift) const;
     bool lift_feet_above_ground(vec3 forward) const;
-    float smooth_lift(FootPin& pin, const FootPlacementLeg& leg) const;
+    vec3 smooth_lift(FootPin& pin, const FootPlacementLeg& leg) const;
     vec3 pin_target(FootPin& pin, vec3 free, vec3 clip_velocity, bool let_go) const;
     vec3 tilt_normal(FootPin& pin, vec3 ground_normal) const;
 };

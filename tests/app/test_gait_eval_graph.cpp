@@ -145,11 +145,13 @@ TEST_CASE("gait-eval: matching's joint speed stays under the limit where pin rel
         CHECK(m.penetration_mm <= 1.0);
         CHECK(m.foot_skate_mm <= 2.0);
     }
-    // Stairs: not yet under 1500 (1650 °/s measured), but the one-tick lift's 4855 is gone.
+    // Stairs: the one-tick lift's 4,855 °/s went first (1,650 left), then the
+    // snaps of the lift's floor on a riser and of the foot's ground rate limit
+    // (1,463 → 1,392 °/s on this run; 1,527 and 1,467 on fast_walk and circle).
     config.terrain_name = "stairs";
     config.terrain = load_terrain("stairs");
     const GaitMetrics stairs = evaluate_gait(config, load_program("builtin:run"), {}, graph);
-    CHECK(stairs.max_joint_speed_deg_s < 2000.0);
+    CHECK(stairs.max_joint_speed_deg_s < 1500.0);
     CHECK(stairs.penetration_mm <= 1.0);
     CHECK(stairs.foot_skate_mm <= 2.0);
 }
