@@ -87,6 +87,13 @@ void FootPlacementJob::solve_leg(const FootPlacementLeg& leg, vec3 target, quat 
     TwoBoneIkJob ik;
     ik.root = h;
     ik.target = target;
+    // smooth_feet: a free leg's reach is soft (kSoftReachFraction), eased out
+    // as the foot plants so a pinned foot still reaches its pin exactly.
+    const float soft = smooth_feet ? 1.0f - smoothstep(state->feet[static_cast<size_t>(&leg - rig->legs.data())].plant) : 0.0f;
+    if (soft > 0.0f) {
+        const float reach = length_of(pose.local_translations[knee]) + length_of(pose.local_translations[ankle]);
+        ik.target = soften_reach(h, target, reach, kSoftReachFraction * soft * reach);
+    }
     // graph_feet: the clip's knee off the hip–ankle midpoint. smooth_feet (matching):
     // the thigh's +Z, since the clip's knee off the midpoint is ill-conditioned on a
     // nearly straight leg and swung the knee about the hip–ankle axis by up to 77°
@@ -227,6 +234,15 @@ vec3 FootPlacementJob::pin_target(FootPin& pin, vec3 free, vec3 clip_velocity, b
         damp_toward(pin.release_offset.z, pin.release_velocity.z, 0.0f, halflife, dt);
     }
     return free + pin.release_offset;
+}
+
+vec3 soften_reach(vec3 root, vec3 target, float reach, float width) {
+    const vec3 d = target - root;
+    const float distance = length_of(d);
+    const float start = reach - width;
+    if (!(width > 0.0f) || !(distance > start) || !(distance > 0.0f)) return target;
+    const float eased = start + width * (1.0f - negexp((distance - start) / width));
+    return root + d * (eased / distance);
 }
 
 vec3 step_tilt_normal(vec3& normal, vec3& velocity, vec3 ground_normal, float dt) {

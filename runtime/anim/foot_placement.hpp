@@ -119,6 +119,19 @@ inline constexpr float kTiltHalflifeS = 0.05f;
 // rest: α = θ/2, ~154 °/s for 15°); held, it converges to the held normal.
 vec3 step_tilt_normal(vec3& normal, vec3& velocity, vec3 ground_normal, float dt);
 
+// smooth_feet's soft reach: a free leg whose target lies near or past full
+// reach is the IK's ill-conditioned case (the knee angle's rate grows without
+// bound as the leg straightens: on the retargeted CMU stairs the knee went 17°
+// → 30° in three ticks at 0.99 → 0.97 of the leg, 1,681 °/s). So a target
+// farther from the hip (root) than reach − width is pulled in to the distance
+// start + width·(1 − e^−(d − start)/width), start = reach − width (e^−x as
+// the rational of the springs, no libm): continuous with its first derivative
+// at start, increasing, and short of reach (far out, rounding reaches it). width ≤ 0 or a nearer
+// target: the target unchanged. The job's width is kSoftReachFraction of the
+// leg, eased out as the foot plants.
+vec3 soften_reach(vec3 root, vec3 target, float reach, float width);
+inline constexpr float kSoftReachFraction = 0.03f;
+
 struct FootPlacementJob {
     FootPlacementState* state = nullptr;
     const FootPlacementRig* rig = nullptr;

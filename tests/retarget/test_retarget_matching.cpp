@@ -65,8 +65,9 @@ TEST_CASE("retarget: matching on the retargeted CMU clips follows the stick on f
             CHECK(m.heading_error_deg <= 10.0);      // measured ≤ 2.0° (−1 on circle: no moving hold)
             CHECK(m.penetration_mm <= 1.0);          // measured 0
             CHECK(m.pop_ratio <= 4.0);               // measured 1.24–1.93 (3.7–21.7 with the clip's knee as pole)
-            // Target < 1500 °/s; measured 920–2,113 (4,939–40,045 with the clip's knee as pole).
-            CHECK(m.max_joint_speed_deg_s < 2500.0);
+            // Target < 1500 °/s: measured 913–1,364 since the feet-over-risers hold and the
+            // soft reach (920–2,113 before them; 4,939–40,045 with the clip's knee as pole).
+            CHECK(m.max_joint_speed_deg_s < 1500.0);
         }
     }
 }

@@ -49,6 +49,8 @@ Terrain raised_ground(float top) {
 bool same_bytes(const FootPlacementState& a, const FootPlacementState& b) {
     return std::memcmp(&a, &b, sizeof a) == 0;
 }
+
+bool same_vec(vec3 a, vec3 b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 }  // namespace
 
 TEST_CASE("FootPlacementJob: bad inputs fail validate() and run() writes nothing", "[foot_placement][job]") {
@@ -514,4 +516,60 @@ TEST_CASE("FootPlacementJob: smooth_feet carries free feet over generated stairs
     CHECK(held_cases > 0);  // the envelope reaches the hold, not only the lift
     WARN("smooth_feet stairs: fastest ankle beyond the clip's " << fastest_extra << " m/s, deepest point " << deepest
                                                               << " m, " << held_cases << " of 300 cases held back");
+}
+
+// soften_reach (smooth_feet's soft reach): generated cases (fixed seed) across
+// its envelope: hips anywhere within 10 m, targets in any direction at 0–2×
+// reach, reach 0.3–2 m, width 0.5–20 % of reach (and ≤ 0). Nearer than
+// reach − width (or no width): the target unchanged, bit for bit. Farther: on
+// the same ray from the hip, never past reach (far out it rounds to it), never nearer than
+// reach − width, increasing with the target's distance, and with a slope of
+// ~1 just past reach − width (no kink where the easing starts).
+TEST_CASE("soften_reach: generated targets, unchanged inside, eased short of reach outside, monotonic, C1",
+          "[foot_placement][soft_reach]") {
+    std::uint32_t seed = 31337u;
+    auto next = [&] { seed = seed * 1664525u + 1013904223u; return static_cast<float>(seed >> 8) / 16777216.0f; };
+    auto distance = [](vec3 a, vec3 b) {
+        const vec3 d = b - a;
+        return std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    };
+    int eased = 0;
+    for (int c = 0; c < 2000; ++c) {
+        const vec3 root(20.0f * next() - 10.0f, 20.0f * next() - 10.0f, 20.0f * next() - 10.0f);
+        vec3 dir(2.0f * next() - 1.0f, 2.0f * next() - 1.0f, 2.0f * next() - 1.0f);
+        const float n = std::sqrt(dir.x * dir.x + dir.y * dir.y + dir.z * dir.z);
+        if (n < 1e-3f) continue;
+        dir = dir / n;
+        const float reach = 0.3f + 1.7f * next(), width = (0.005f + 0.195f * next()) * reach;
+        const float d = 2.0f * reach * next();
+        const vec3 target = root + dir * d;
+        INFO("case " << c << ": reach " << reach << " width " << width << " distance " << d);
+        const vec3 out = soften_reach(root, target, reach, width);
+        CHECK(same_vec(soften_reach(root, target, reach, 0.0f), target));
+        CHECK(same_vec(soften_reach(root, target, reach, -width), target));
+        const float start = reach - width;
+        if (d <= start) {
+            CHECK(same_vec(out, target));
+            continue;
+        }
+        ++eased;
+        const float got = distance(root, out);
+        CHECK(got <= reach + 2e-5f);  // short of reach; far out it rounds to it (hips 10 m out: ulps of 1e-6 m)
+        CHECK(got >= start - 1e-4f * reach);
+        const vec3 along = (out - root) / got;  // the same ray
+        CHECK(along.x * dir.x + along.y * dir.y + along.z * dir.z > 1.0f - 1e-5f);
+        // Increasing: a target 1 mm farther is eased at least as far.
+        CHECK(distance(root, soften_reach(root, root + dir * (d + 1e-3f), reach, width)) >= got - 1e-5f);
+    }
+    CHECK(eased > 500);
+    // No kink at start: the slope just past it is ~1, and far out it flattens.
+    const vec3 root(0.0f), dir(0.0f, -1.0f, 0.0f);
+    for (const float width : {0.01f, 0.03f, 0.1f}) {
+        const float reach = 0.9f, start = reach - width, step = 1e-3f * width;
+        const float just_past = distance(root, soften_reach(root, dir * (start + step), reach, width));
+        CHECK((just_past - start) / step == Approx(1.0).margin(0.01));
+        const float far = distance(root, soften_reach(root, dir * (reach + 10.0f * width), reach, width));
+        CHECK(far > reach - 0.02f * width);
+        CHECK(far < reach);
+    }
 }
