@@ -200,12 +200,53 @@ double measure_drift(const Clip& c, const std::vector<unsigned char>& kind, Cont
     return worst;
 }
 
+// The height of the ground the puppet's feet stand on: the median, over the
+// foot-frames the source plants, of the planted point's height (kind 1: the sole
+// under the ankle, the rest pose's ankle height below it in the foot's frame;
+// kind 2: the ball, the toe joint). Without contacts, the 2nd percentile over
+// frames of the lowest foot joint, as the source's floor is found.
+float planted_ground(const Clip& c, const std::vector<unsigned char>& kind) {
+    std::vector<quat> rest_rot;
+    std::vector<vec3> rest_pos;
+    rest_model_pose(c.skeleton, rest_rot, rest_pos);
+    const ModelFrames m = model_frames(c);
+    std::vector<float> heights;
+    for (int f = 0; f < c.frame_count; ++f)
+        for (int foot = 0; foot < 2; ++foot) {
+            const int ankle = kFootRole[foot], toe = ankle + 1;
+            const size_t a = static_cast<size_t>(ankle), t = static_cast<size_t>(toe);
+            const int k = kind[at(f, 2, foot)];
+            if (k == 0) continue;
+            // The sole under the ankle, carried from the rest pose by the foot's rotation since rest.
+            const vec3 rest_sole = quat_rotate(quat_conjugate(rest_rot[a]), vec3(0.0f, rest_pos[t].y - rest_pos[a].y, 0.0f));
+            heights.push_back(k == 1 ? (m.position(f, ankle) + quat_rotate(m.rotation(f, ankle), rest_sole)).y : m.position(f, toe).y);
+        }
+    if (heights.empty()) {
+        for (int f = 0; f < c.frame_count; ++f) {
+            float low = m.position(f, role::foot_l).y;
+            for (int p : {role::foot_l, role::toe_l, role::foot_r, role::toe_r}) low = std::min(low, m.position(f, p).y);
+            heights.push_back(low);
+        }
+        std::sort(heights.begin(), heights.end());
+        return heights[heights.size() / 50];
+    }
+    const auto mid = heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 2);
+    std::nth_element(heights.begin(), mid, heights.end());
+    return *mid;
+}
+
 }  // namespace
 
 void fix_contacts(const ModelFrames& source, const HumanoidChains& h, const SourceToPuppet& sp, const RetargetOptions& o,
                   float puppet_leg, RetargetResult& result) {
     Clip& c = result.clip;
     result.contact_kind = detect(source, h, sp, o, puppet_leg, c.frame_rate);
+    // The puppet's feet onto the ground: its legs need not have the source's
+    // proportions, so at the source's scaled hip height its planted feet float or
+    // sink (CMU subject 16 on the default puppet: 6-8 cm above the ground).
+    // The pelvis moves by that, before the contacts pin the feet.
+    result.ground_shift_m = planted_ground(c, result.contact_kind);
+    for (int f = 0; f < c.frame_count; ++f) c.translations[at(f, c.joint_count(), 0)].y -= static_cast<float>(result.ground_shift_m);
     result.contacts.max_drift_before_ik_m = measure_drift(c, result.contact_kind, nullptr);
     if (o.fix_contacts) pin_feet(c, result.contact_kind, o, result.contacts);
     measure_drift(c, result.contact_kind, &result.contacts);

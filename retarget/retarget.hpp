@@ -50,6 +50,10 @@ struct RetargetResult {
     std::vector<BoneAgreement> bones;  // one per puppet joint
     ContactReport contacts;
     double scale = 1.0;          // puppet leg length / source leg length (source units)
+    // Metres the pelvis was lowered (negative: raised) so the puppet's feet stand
+    // on the ground where the source's did: the puppet's legs need not have the
+    // source's proportions, so its feet at the source's scaled hip height float or sink.
+    double ground_shift_m = 0.0;
     // Per frame and foot (0 left, 1 right): 0 free, 1 heel (ankle) planted, 2 ball planted.
     std::vector<unsigned char> contact_kind;
 };

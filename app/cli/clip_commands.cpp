@@ -135,18 +135,18 @@ int clip_retarget_command(const ClipOptions& o) {
         for (size_t k = 0; k < 5; ++k)
             effectors += fmt::format("{}{}:{}", k ? "," : "", json::quote(effector_names[k]),
                                      json::quote(s.joint_names[static_cast<size_t>(h.effectors[k])]));
-        fmt::print("{{\"file\":{},\"output\":{},\"frames\":{},\"frame_rate\":{},\"scale\":{},\"source_leg_length\":{},"
+        fmt::print("{{\"file\":{},\"output\":{},\"frames\":{},\"frame_rate\":{},\"scale\":{},\"source_leg_length\":{},\"ground_shift_m\":{},"
                    "\"side_from\":{},\"names_agree\":{},\"effectors\":{{{}}},\"chains\":{{{}}},\"notes\":[{}],\"bones\":[{}],"
                    "\"min_mean_cos\":{},\"min_cos\":{},\"contacts\":{{\"runs\":{},\"frames\":{},\"max_drift_m\":{},\"mean_drift_m\":{},"
                    "\"max_drift_before_ik_m\":{},\"max_root_drop_m\":{}}}}}\n",
                    json::quote(o.file), json::quote(o.output_file), r.clip.frame_count, json::number(r.clip.frame_rate),
-                   json::number(r.scale), json::number(h.source_leg_length), json::quote(h.side_from), h.names_agree ? "true" : "false",
+                   json::number(r.scale), json::number(h.source_leg_length), json::number(r.ground_shift_m), json::quote(h.side_from), h.names_agree ? "true" : "false",
                    effectors, roles, notes, bones, json::number(worst_mean), json::number(worst_min), r.contacts.runs,
                    r.contacts.frames, json::number(r.contacts.max_drift_m), json::number(r.contacts.mean_drift_m),
                    json::number(r.contacts.max_drift_before_ik_m), json::number(r.contacts.max_root_drop_m));
     } else {
-        fmt::print("{}: humanoid found (sides from {}), {} frames at {} Hz, scale {:.4g}\n", o.file, h.side_from,
-                   r.clip.frame_count, r.clip.frame_rate, r.scale);
+        fmt::print("{}: humanoid found (sides from {}), {} frames at {} Hz, scale {:.4g}, pelvis lowered {:.1f} mm onto the ground\n",
+                   o.file, h.side_from, r.clip.frame_count, r.clip.frame_rate, r.scale, r.ground_shift_m * 1000.0);
         for (size_t k = 0; k < r.bones.size(); ++k)
             fmt::print("{:>12} <- {:<24} mean cos {:.4f}  min {:.4f}\n", r.bones[k].puppet_joint, r.bones[k].source_joint,
                        r.bones[k].mean_cos, r.bones[k].min_cos);
