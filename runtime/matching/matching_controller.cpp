@@ -10,7 +10,25 @@ namespace marionette {
 
 namespace {
 constexpr float kLn2 = 0.69314718f;
-constexpr int kNearAheadFrames = 3;  // a search answer this close ahead in the same clip is where the clip goes anyway
+// A search answer this close (frames) ahead of the current frame in the same
+// clip is where the clip goes anyway; with the stick at rest, one this close
+// behind replays what was just shown: jumping back a few frames at every search
+// looped three frames of a stop for seconds, and the feet slid by the loop's
+// root motion. (Moving, the jump back stays: refusing it raised the CMU
+// database's joint speeds on circle and run to 1,505-1,908 deg/s.)
+constexpr int kNearFrames = 3;
+// A clip whose last frame's hips move slower than this (m/s, horizontally) ends
+// at rest: with the stick at rest it holds that pose (rests_at_end).
+constexpr float kRestHipsSpeed = 0.15f;
+
+bool goal_at_rest(const TrajectoryGoal& goal) { return goal.vx * goal.vx + goal.vz * goal.vz < 1e-6f; }
+
+// Whether the clip `frame` is in ends at rest: its last frame's hips move slower than kRestHipsSpeed.
+bool rests_at_end(const MatchingDatabase& db, int frame) {
+    const float* last = db.frame_raw(db.clip_end[static_cast<size_t>(frame)] - 1);
+    const float vx = last[kMatchGroupBegin[kMatchHipsVelocity]], vz = last[kMatchGroupBegin[kMatchHipsVelocity] + 2];
+    return vx * vx + vz * vz < kRestHipsSpeed * kRestHipsSpeed;
+}
 
 quat nlerp(quat a, quat b, float t) {
     if (quat_dot(a, b) < 0.0f) b = quat(-b.w, -b.x, -b.y, -b.z);
@@ -268,7 +286,10 @@ bool MatchingController::step(MatchingState& s, const MatchingInput& in, LocalPo
         } else {
             s.frame = db_.clip_end[static_cast<size_t>(s.frame)] - 2 < 0 ? 0 : db_.clip_end[static_cast<size_t>(s.frame)] - 2;
             s.frame_time = 0.999f;
-            at_end = true;
+            // A clip that ends at rest holds its last pose while the stick is at
+            // rest (searches still run, that pose the one to beat); else the end
+            // forces a jump.
+            at_end = !(goal_at_rest(in.goal) && rests_at_end(db_, s.frame));
             break;
         }
     }
@@ -284,14 +305,21 @@ bool MatchingController::step(MatchingState& s, const MatchingInput& in, LocalPo
         desired_features(s, in.goal, raw);
         db_.normalise(raw, query);
         MatchingResult best;
-        if (db_.searchable[static_cast<size_t>(s.frame)] && !at_end) best = {s.frame, matching_cost(db_, query, s.frame)};
+        // The current frame is the one to beat where a jump could land, and also
+        // in the last 1/3 s of a clip that ends at rest while the stick is at rest
+        // (else the search jumped back to the last landable frame every time and
+        // looped the stop's end, the feet sliding by the loop's root motion).
+        const bool may_stay = db_.searchable[static_cast<size_t>(s.frame)] || (goal_at_rest(in.goal) && rests_at_end(db_, s.frame));
+        if (may_stay && !at_end) best = {s.frame, matching_cost(db_, query, s.frame)};
         best = search_matching_accelerated(db_, query, best);
         s.since_search = 0.0f;
         ++s.searches;
         s.last_cost = best.cost;
         const bool same_clip = db_.clip_end[static_cast<size_t>(best.frame)] == db_.clip_end[static_cast<size_t>(s.frame)];
-        const bool just_ahead = same_clip && best.frame > s.frame && best.frame - s.frame <= kNearAheadFrames;
-        if (best.frame >= 0 && best.frame != s.frame && !just_ahead) jump(s, best.frame);
+        const bool ahead = best.frame > s.frame && best.frame - s.frame <= kNearFrames;
+        const bool behind = best.frame < s.frame && s.frame - best.frame <= kNearFrames && goal_at_rest(in.goal);
+        const bool near = same_clip && (ahead || behind);
+        if (best.frame >= 0 && best.frame != s.frame && !near) jump(s, best.frame);
     }
     const size_t sf = static_cast<size_t>(db_.source_frame[static_cast<size_t>(s.frame)]);
     s.contacts = source_.contacts[s.frame_time < 0.5f || s.frame + 1 >= db_.clip_end[static_cast<size_t>(s.frame)] ? sf : sf + 1];
