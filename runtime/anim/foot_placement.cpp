@@ -89,10 +89,10 @@ void FootPlacementJob::solve_leg(const FootPlacementLeg& leg, vec3 target, quat 
     ik.target = target;
     // smooth_feet: a free leg's reach is soft (kSoftReachFraction), eased out
     // as the foot plants so a pinned foot still reaches its pin exactly.
-    const float soft = smooth_feet ? 1.0f - smoothstep(state->feet[static_cast<size_t>(&leg - rig->legs.data())].plant) : 0.0f;
-    if (soft > 0.0f) {
+    const float width = soft_reach_width(static_cast<int>(&leg - rig->legs.data()));
+    if (width > 0.0f) {
         const float reach = length_of(pose.local_translations[knee]) + length_of(pose.local_translations[ankle]);
-        ik.target = soften_reach(h, target, reach, kSoftReachFraction * soft * reach);
+        ik.target = soften_reach(h, target, reach, width);
     }
     // graph_feet: the clip's knee off the hip–ankle midpoint. smooth_feet (matching):
     // the thigh's +Z, since the clip's knee off the midpoint is ill-conditioned on a
@@ -236,6 +236,57 @@ vec3 FootPlacementJob::pin_target(FootPin& pin, vec3 free, vec3 clip_velocity, b
     return free + pin.release_offset;
 }
 
+// smooth_feet's soft-reach width (m) for leg i: kSoftReachFraction of the leg,
+// eased out as the foot plants; 0 without smooth_feet.
+float FootPlacementJob::soft_reach_width(int i) const {
+    if (!smooth_feet) return 0.0f;
+    const FootPlacementLeg& leg = rig->legs[static_cast<size_t>(i)];
+    const float reach = length_of(pose.local_translations[static_cast<size_t>(leg.knee)]) +
+                        length_of(pose.local_translations[static_cast<size_t>(leg.ankle)]);
+    return kSoftReachFraction * (1.0f - smoothstep(state->feet[static_cast<size_t>(i)].plant)) * reach;
+}
+
+float reach_drop_needed(vec3 hip, vec3 target, float reach, float cap) {
+    const vec3 d = target - hip;
+    const float horizontal2 = d.x * d.x + d.z * d.z;
+    // Out of reach however far the hip comes down: as near as it gets, level with the target.
+    const float drop = reach > 0.0f && horizontal2 < reach * reach ? -d.y - std::sqrt(reach * reach - horizontal2) : -d.y;
+    return drop > cap ? cap : (drop > 0.0f ? drop : 0.0f);
+}
+
+// smooth_feet: the body lowered (kMaxReachDropM at most) so every pinned
+// ankle's target lies within its leg's reach; see kPinnedReachFraction.
+void FootPlacementJob::lower_for_reach(const vec3 (&targets)[2]) const {
+    FootPlacementState& s = *state;
+    float need = 0.0f;
+    for (int i = 0; i < 2; ++i) {
+        if (s.feet[static_cast<size_t>(i)].contact != 1) continue;
+        const FootPlacementLeg& leg = rig->legs[static_cast<size_t>(i)];
+        const float reach = length_of(pose.local_translations[static_cast<size_t>(leg.knee)]) +
+                            length_of(pose.local_translations[static_cast<size_t>(leg.ankle)]);
+        const float l = (reach - soft_reach_width(i)) * kPinnedReachFraction;
+        // Eased in as the foot plants: a pin starts wherever the foot touched
+        // down, so its need can start at any size (taken at once, it dropped
+        // the body in a tick and turned the shins at up to 2,034 °/s).
+        const float n = reach_drop_needed(pose.model_positions[static_cast<size_t>(leg.hip)], targets[i], l, kMaxReachDropM) *
+                        smoothstep(s.feet[static_cast<size_t>(i)].plant);
+        need = n > need ? n : need;
+    }
+    if (!s.started || need >= s.reach_drop) {
+        s.reach_drop = need;
+        s.reach_drop_velocity = 0.0f;
+    } else if (dt > 0.0f) {
+        damp_toward(s.reach_drop, s.reach_drop_velocity, need, kReachDropHalflifeS, dt);
+        if (s.reach_drop < need) {  // the spring undershot a need that is still there
+            s.reach_drop = need;
+            s.reach_drop_velocity = 0.0f;
+        }
+    }
+    if (!(s.reach_drop > 0.0f)) return;
+    pose.local_translations[static_cast<size_t>(rig->root)].y -= s.reach_drop;
+    for (vec3& p : pose.model_positions) p.y -= s.reach_drop;
+}
+
 vec3 soften_reach(vec3 root, vec3 target, float reach, float width) {
     const vec3 d = target - root;
     const float distance = length_of(d);
@@ -327,6 +378,8 @@ bool FootPlacementJob::run() const {
     for (vec3& p : pose.model_positions) p.y += s.body_offset;
 
     const vec3 forward = quat_rotate(pose.model_rotations[root], vec3(0.0f, 0.0f, 1.0f));
+    vec3 targets[2];
+    quat foot_world[2];
     for (int i = 0; i < 2; ++i) {
         const FootPlacementLeg& leg = rig->legs[static_cast<size_t>(i)];
         FootPin& pin = s.feet[static_cast<size_t>(i)];
@@ -369,8 +422,11 @@ bool FootPlacementJob::run() const {
         const vec3 ground_normal = query_ground(*terrain, target.x, target.z).normal;
         const vec3 normal = smooth_feet ? tilt_normal(pin, ground_normal) : ground_normal;
         const quat tilt = quat_slerp(quat_identity(), quat_from_to(up, normal), smoothstep(pin.plant));
-        solve_leg(leg, target, quat_normalize(quat_mul(tilt, pose.model_rotations[ankle])), forward);
+        targets[i] = target;
+        foot_world[i] = quat_normalize(quat_mul(tilt, pose.model_rotations[ankle]));
     }
+    if (smooth_feet) lower_for_reach(targets);
+    for (int i = 0; i < 2; ++i) solve_leg(rig->legs[static_cast<size_t>(i)], targets[i], foot_world[i], forward);
     // Cannot fail: validate() checked the sizes and the order FK needs.
     if (!LocalToModelJob{parents, pose.local(), pose.model()}.run()) return false;
     if (keep_above_ground && lift_feet_above_ground(forward) &&

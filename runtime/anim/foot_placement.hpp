@@ -51,6 +51,10 @@ struct FootPin {
 struct FootPlacementState {
     std::array<FootPin, 2> feet{};
     float body_offset = 0.0f;    // metres the body is raised to meet the ground
+    // smooth_feet only: metres the body is lowered so every pinned ankle stays
+    // within its leg's reach (lower_for_reach), and its rate (m/s).
+    float reach_drop = 0.0f;
+    float reach_drop_velocity = 0.0f;
     std::int32_t started = 0;    // 0 until a tick has placed the feet
 };
 
@@ -132,6 +136,28 @@ vec3 step_tilt_normal(vec3& normal, vec3& velocity, vec3 ground_normal, float dt
 vec3 soften_reach(vec3 root, vec3 target, float reach, float width);
 inline constexpr float kSoftReachFraction = 0.03f;
 
+// smooth_feet's lowering for reach: a pinned ankle stays where it touched down
+// while the clip's body moves on; where the clip lifts the heel before the leg
+// would be straight (the retargeted CMU stops: the rear foot's ankle 0.886 m
+// from the hip, reach 0.87 m) the pin fell out of reach and the IK dragged the
+// planted foot (12-30 mm of skate). So the body is lowered as far as the
+// farthest pinned ankle needs, to kPinnedReachFraction of its (soft) reach (the
+// two-bone IK's soft_reach_start: past it the IK eases the reach in and the
+// ankle leaves its pin), at
+// most kMaxReachDropM; it follows a deeper need at once (the need is
+// continuous: the pin is fixed and the body moves smoothly) and rises back
+// through a critically damped spring of halflife kReachDropHalflifeS.
+inline constexpr float kPinnedReachFraction = 0.98f;
+inline constexpr float kMaxReachDropM = 0.1f;
+inline constexpr float kReachDropHalflifeS = 0.1f;
+
+// How far (m, in [0, cap]) a hip must come down for an ankle `target` to lie
+// within `reach` of it: 0 when it already does; else the least drop that puts
+// it on the sphere of that radius; where no drop does (the target farther than
+// reach horizontally, or above the hip), the one that brings it nearest (the
+// hip level with the target, 0 when it is above). Clamped to cap.
+float reach_drop_needed(vec3 hip, vec3 target, float reach, float cap);
+
 struct FootPlacementJob {
     FootPlacementState* state = nullptr;
     const FootPlacementRig* rig = nullptr;
@@ -159,7 +185,8 @@ struct FootPlacementJob {
     // follows a spring (kFootGroundHalflifeS), not the 3 m/s limit; and the
     // two-bone IK bends the knee toward the thigh's +Z, not toward the clip's knee;
     // and the ground normal a foot tilts to follows the one under it through a
-    // critically damped spring (kTiltHalflifeS), so a crease does not snap it.
+    // critically damped spring (kTiltHalflifeS), so a crease does not snap it;
+    // and the body is lowered for a pinned ankle out of reach (lower_for_reach).
     bool smooth_feet = false;
 
     // False without a state, rig or terrain, with an invalid rig (a toe or tip
@@ -173,6 +200,8 @@ private:
     vec3 thigh_pole(const FootPlacementLeg& leg, vec3 forward) const;
     float foot_depth(const FootPlacementLeg& leg, vec3 shift) const;
     bool lift_feet_above_ground(vec3 forward) const;
+    void lower_for_reach(const vec3 (&targets)[2]) const;
+    float soft_reach_width(int leg) const;
     vec3 smooth_lift(FootPin& pin, const FootPlacementLeg& leg) const;
     vec3 pin_target(FootPin& pin, vec3 free, vec3 clip_velocity, bool let_go) const;
     vec3 tilt_normal(FootPin& pin, vec3 ground_normal) const;

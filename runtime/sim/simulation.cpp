@@ -117,9 +117,10 @@ void hash_matching(HashBytes& h, const MatchingState& m, const FootPlacementStat
     const double world[3] = {m.world_angle, m.world_dx, m.world_dz};
     h.add(world, sizeof world);
     const TrajectorySpring& sp = m.spring;
-    const float f[13] = {m.frame_time, sp.px, sp.pz, sp.vx, sp.vz, sp.ax, sp.az, sp.heading, sp.heading_rate,
-                         m.since_search, m.since_jump, m.last_cost, feet.body_offset};
-    hash_floats(h, f, 13);
+    const float f[15] = {m.frame_time, sp.px,          sp.pz,          sp.vx,          sp.vz,
+                         sp.ax,        sp.az,          sp.heading,     sp.heading_rate, m.since_search,
+                         m.since_jump, m.last_cost,    feet.body_offset, feet.reach_drop, feet.reach_drop_velocity};
+    hash_floats(h, f, 15);
     const std::int64_t counters[2] = {m.searches, m.jumps};
     h.add(counters, sizeof counters);
     for (size_t j = 0; j < joints && j < m.offset_rotation.size(); ++j) {

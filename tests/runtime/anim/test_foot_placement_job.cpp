@@ -573,3 +573,113 @@ TEST_CASE("soften_reach: generated targets, unchanged inside, eased short of rea
         CHECK(far < reach);
     }
 }
+
+// reach_drop_needed (smooth_feet's lowering for reach): generated cases (fixed
+// seed) across its envelope: hips anywhere within 10 m, targets in any
+// direction at 0–2× reach, reach 0.3–2 m, cap 0–60 % of reach. Always in [0, cap];
+// 0 when the target is within reach. Where a drop within the cap reaches it,
+// the hip lowered by the answer has the target on the reach sphere and lowered
+// by 1 mm less does not reach it (the least drop, not merely one); where none
+// does, the answer brings the target nearest (1 mm more or less is no nearer).
+TEST_CASE("reach_drop_needed: generated hips and targets, the least drop that reaches, capped", "[foot_placement][reach_drop]") {
+    std::uint32_t seed = 4242u;
+    auto next = [&] { seed = seed * 1664525u + 1013904223u; return static_cast<float>(seed >> 8) / 16777216.0f; };
+    auto distance = [](vec3 a, vec3 b) {
+        const vec3 d = b - a;
+        return std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    };
+    int reached = 0, nearest = 0;
+    for (int c = 0; c < 3000; ++c) {
+        const vec3 hip(20.0f * next() - 10.0f, 20.0f * next() - 10.0f, 20.0f * next() - 10.0f);
+        vec3 dir(2.0f * next() - 1.0f, 2.0f * next() - 1.0f, 2.0f * next() - 1.0f);
+        const float n = std::sqrt(dir.x * dir.x + dir.y * dir.y + dir.z * dir.z);
+        if (n < 1e-3f) continue;
+        dir = dir / n;
+        const float reach = 0.3f + 1.7f * next(), cap = 0.6f * reach * next();
+        // Every other case just past reach and below the hip, as a pinned ankle is.
+        if (c % 2) dir.y = -std::fabs(dir.y);
+        const vec3 target = hip + dir * ((c % 2 ? 0.9f + 0.3f * next() : 2.0f * next()) * reach);
+        INFO("case " << c << ": reach " << reach << " cap " << cap << " distance " << distance(hip, target) << " dir.y " << dir.y);
+        const float drop = reach_drop_needed(hip, target, reach, cap);
+        REQUIRE(drop >= 0.0f);
+        REQUIRE(drop <= cap);
+        if (distance(hip, target) <= reach * (1.0f - 1e-5f)) {
+            CHECK(drop == 0.0f);
+            continue;
+        }
+        const vec3 lowered = hip - vec3(0.0f, drop, 0.0f);
+        const float at = distance(lowered, target);
+        if (at <= reach * (1.0f + 1e-4f)) {
+            ++reached;
+            CHECK(at >= reach * (1.0f - 1e-4f));
+            if (drop > 1e-3f) CHECK(distance(lowered + vec3(0.0f, 1e-3f, 0.0f), target) > reach);
+        } else {
+            ++nearest;
+            if (drop + 1e-3f <= cap) CHECK(distance(lowered - vec3(0.0f, 1e-3f, 0.0f), target) >= at * (1.0f - 1e-6f));
+            if (drop >= 1e-3f) CHECK(distance(lowered + vec3(0.0f, 1e-3f, 0.0f), target) >= at * (1.0f - 1e-6f));
+        }
+    }
+    INFO(reached << " reached, " << nearest << " as near as it gets");
+    CHECK(reached > 500);
+    CHECK(nearest > 500);
+    CHECK(reach_drop_needed(vec3(0.0f), vec3(0.0f, -1.0f, 0.0f), 0.0f, 0.1f) == 0.1f);  // no leg: hip to target's level, capped
+}
+
+// smooth_feet lowers the body for a pinned foot the clip's body walks away
+// from (the retargeted CMU stop: the heel lifts while the hip moves on):
+// nearly straight legs, both feet in contact, the clip's pelvis sliding
+// forward at 0.3 m/s (slow enough to stay pinned) for 0.8 s (0.24 m, under
+// the 0.25 m slip limit) at 240 Hz. With smooth_feet the ankles stay on their
+// pins (< 0.5 mm) and the body comes down by at most kMaxReachDropM, a little
+// per tick; graph_feet (no lowering) drags them. Then the clip lifts the feet
+// and the body rises back.
+TEST_CASE("FootPlacementJob: smooth_feet lowers the body so a pinned foot stays in reach", "[foot_placement][job][reach_drop]") {
+    const FootPlacementRig rig = make_foot_placement_rig(kLegParents, kLeftAnkle, kRightAnkle);
+    const Terrain flat = raised_ground(0.0f);
+    const float dt = 1.0f / 240.0f;
+    float worst_slide[2] = {0.0f, 0.0f};
+    for (const bool smooth : {true, false}) {
+        FootPlacementState state;
+        vec3 pins[2];
+        float previous_drop = 0.0f, fastest_drop = 0.0f;
+        for (int t = 0; t <= 432; ++t) {  // 0.8 s pinned, then 1 s lifted
+            const bool pinned = t <= 192;
+            ClipPose pose;
+            for (const int hip : {1, 4}) {
+                pose.local_rotations[static_cast<size_t>(hip)] = quat_axis_angle(vec3(1.0f, 0.0f, 0.0f), -0.1);
+                pose.local_rotations[static_cast<size_t>(hip) + 1] = quat_axis_angle(vec3(1.0f, 0.0f, 0.0f), 0.2);
+            }
+            pose.local_translations[0].z = 0.3f * dt * static_cast<float>(pinned ? t : 192);
+            REQUIRE(LocalToModelJob{kLegParents, pose.spans().local(), pose.spans().model()}.run());
+            FootPlacementJob job{&state, &rig, &flat, pinned ? kBothFeetInContact : std::uint8_t{0}, t == 0 ? 0.0f : dt,
+                                 0.15f, 10.0f, kLegParents, pose.spans()};
+            job.smooth_feet = smooth;
+            REQUIRE(job.run());
+            CHECK(state.reach_drop >= 0.0f);
+            CHECK(state.reach_drop <= kMaxReachDropM);
+            if (t > 0) fastest_drop = std::max(fastest_drop, std::fabs(state.reach_drop - previous_drop) / dt);
+            previous_drop = state.reach_drop;
+            for (int foot = 0; foot < 2; ++foot) {
+                const vec3 ankle = pose.model_positions[static_cast<size_t>(rig.legs[static_cast<size_t>(foot)].ankle)];
+                if (t == 0) pins[foot] = ankle;
+                if (pinned) {
+                    REQUIRE(state.feet[static_cast<size_t>(foot)].contact == 1);
+                    const vec3 d = ankle - pins[foot];
+                    worst_slide[smooth ? 0 : 1] = std::max(worst_slide[smooth ? 0 : 1], std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z));
+                }
+            }
+            if (smooth && t == 192) CHECK(state.reach_drop > 0.01f);  // the legs needed it
+        }
+        if (smooth) {
+            INFO("fastest the body came down or rose: " << fastest_drop << " m/s");
+            CHECK(fastest_drop < 0.5f);
+            CHECK(state.reach_drop < 1e-3f);  // risen back within the second after the lift
+        } else {
+            CHECK(state.reach_drop == 0.0f);  // graph_feet never lowers
+        }
+    }
+    INFO("pinned ankles moved up to " << worst_slide[0] * 1000.0f << " mm (smooth_feet), " << worst_slide[1] * 1000.0f
+                                      << " mm (graph_feet)");
+    CHECK(worst_slide[0] < 5e-4f);
+    CHECK(worst_slide[1] > 5e-3f);
+}
