@@ -88,11 +88,15 @@ void FootPlacementJob::solve_leg(const FootPlacementLeg& leg, vec3 target, quat 
     ik.root = h;
     ik.target = target;
     // smooth_feet: a free leg's reach is soft (kSoftReachFraction), eased out
-    // as the foot plants so a pinned foot still reaches its pin exactly.
-    const float width = soft_reach_width(static_cast<int>(&leg - rig->legs.data()));
-    if (width > 0.0f) {
+    // as the foot plants; a pinned foot aims at its pin's pre-image through the
+    // softening, so it lands on the pin (eased out again as it lets go).
+    if (smooth_feet) {
+        const int i = static_cast<int>(&leg - rig->legs.data());
+        const float width = soft_reach_width(i), pinned = pinned_weight(i);
         const float reach = length_of(pose.local_translations[knee]) + length_of(pose.local_translations[ankle]);
-        ik.target = soften_reach(h, target, reach, width);
+        vec3 aim = target;
+        if (pinned > 0.0f) aim = target + (pinned_reach_target(h, target, reach, width, ik.soft_reach_start) - target) * pinned;
+        ik.target = width > 0.0f ? soften_reach(h, aim, reach, width) : aim;
     }
     // graph_feet: the clip's knee off the hip–ankle midpoint. smooth_feet (matching):
     // the thigh's +Z, since the clip's knee off the midpoint is ill-conditioned on a
@@ -244,6 +248,55 @@ float FootPlacementJob::soft_reach_width(int i) const {
     const float reach = length_of(pose.local_translations[static_cast<size_t>(leg.knee)]) +
                         length_of(pose.local_translations[static_cast<size_t>(leg.ankle)]);
     return kSoftReachFraction * (1.0f - smoothstep(state->feet[static_cast<size_t>(i)].plant)) * reach;
+}
+
+// 1 while leg i is pinned, eased out (smoothstep) over release_s after it lets go.
+float FootPlacementJob::pinned_weight(int i) const {
+    const FootPin& pin = state->feet[static_cast<size_t>(i)];
+    return pin.contact == 1 ? 1.0f : 1.0f - smoothstep(clamp01(pin.release));
+}
+
+namespace {
+// The distance d whose soften_reach image is `distance` (start = reach − width).
+float unsoften_distance(float distance, float reach, float width) {
+    const float start = reach - width;
+    if (!(width > 0.0f) || !(distance > start)) return distance;
+    // negexp(x) = 1 − u  ⇔  x + 0.48x² + 0.235x³ = u / (1 − u): increasing and
+    // convex for x ≥ 0, so Newton's method from x = u / (1 − u) (at or right of
+    // the root) descends onto it without overshooting.
+    const float u = (distance - start) / width;
+    const float c = u / (1.0f - u);
+    float x = c;
+    for (int step = 0; step < 24; ++step) {
+        const float p = x + 0.48f * x * x + 0.235f * x * x * x - c;
+        const float slope = 1.0f + 0.96f * x + 0.705f * x * x;
+        x -= p / slope;
+    }
+    return start + width * x;
+}
+
+// The distance d whose two-bone IK soft-reach image is `distance`
+// (d' = s + r·x/(x + r), x = d − s, s = soft_start·full, r = full − s).
+float unsoften_ik_distance(float distance, float full, float soft_start) {
+    const float s = soft_start * full, r = full - s;
+    if (!(distance > s) || !(r > 0.0f)) return distance;
+    const float x = distance - s;
+    return s + r * x / (r - x);
+}
+}  // namespace
+
+vec3 pinned_reach_target(vec3 root, vec3 target, float reach, float width, float ik_soft_start) {
+    const vec3 d = target - root;
+    const float distance = length_of(d);
+    if (!(distance > 0.0f) || !(reach > 0.0f)) return target;
+    // The softened range: soften_reach stays short of reach, and the IK's soft
+    // reach maps reach to s + r/2 (s = ik_soft_start·reach, r = reach − s).
+    const float top = width > 0.0f ? reach * ik_soft_start + 0.5f * (reach - reach * ik_soft_start) : reach;
+    const float exact = kPinExactReachFraction * top;
+    const float inside = distance < exact ? distance : exact;
+    const float before_ik = unsoften_ik_distance(inside, reach, ik_soft_start);
+    const float aimed = unsoften_distance(before_ik, reach, width) + (distance - inside);
+    return root + d * (aimed / distance);
 }
 
 float reach_drop_needed(vec3 hip, vec3 target, float reach, float cap) {

@@ -136,6 +136,20 @@ vec3 step_tilt_normal(vec3& normal, vec3& velocity, vec3 ground_normal, float dt
 vec3 soften_reach(vec3 root, vec3 target, float reach, float width);
 inline constexpr float kSoftReachFraction = 0.03f;
 
+// smooth_feet's pinned reach: the soft reach (soften_reach with `width`, then the
+// two-bone IK's own, from `ik_soft_start` of reach) is not idempotent, so a pin
+// set where a softened ankle touched down was softened again and pulled the
+// ankle a few mm off it, then let it creep back as the width eased out with the
+// plant (2.1 mm of skate on the CMU fast_walk stop). This is the target whose
+// softened image is `target` (the pre-image along root → target): a pinned
+// ankle then lands on its pin exactly while the pin is within
+// kPinExactReachFraction of the leg's softened range; beyond it the pre-image
+// of that distance plus the excess, so the result stays continuous and
+// increasing. No libm: the soft reach's e^−x is the springs' rational, inverted
+// by Newton's method (a fixed count of steps).
+vec3 pinned_reach_target(vec3 root, vec3 target, float reach, float width, float ik_soft_start);
+inline constexpr float kPinExactReachFraction = 0.995f;
+
 // smooth_feet's lowering for reach: a pinned ankle stays where it touched down
 // while the clip's body moves on; where the clip lifts the heel before the leg
 // would be straight (the retargeted CMU stops: the rear foot's ankle 0.886 m
@@ -202,6 +216,7 @@ private:
     bool lift_feet_above_ground(vec3 forward) const;
     void lower_for_reach(const vec3 (&targets)[2]) const;
     float soft_reach_width(int leg) const;
+    float pinned_weight(int leg) const;
     vec3 smooth_lift(FootPin& pin, const FootPlacementLeg& leg) const;
     vec3 pin_target(FootPin& pin, vec3 free, vec3 clip_velocity, bool let_go) const;
     vec3 tilt_normal(FootPin& pin, vec3 ground_normal) const;

@@ -3,10 +3,9 @@
 // load (the path `marionette graph build --asf 16.asf *.amc` takes), make the
 // graph whose labelled locomotion clips are the matching database; gait-eval
 // then drives `[motion] source = "matching"` with it over the shipped programs.
-// The targets that hold are asserted here, and pop ratio and joint speed since
-// matching's knee pole follows the thigh (branch matching4); foot skate on
-// fast_walk and joint speed < 1500 °/s on slope/stairs do not hold yet
-// (docs/motion-matching.md, "CMU database", "Knee pole").
+// Every target of the issue is asserted here on the shipped programs: distance
+// ratio, start latency, heading error, penetration, pop ratio, joint speed
+// < 1500 °/s and foot skate ≤ 2 mm (docs/motion-matching.md, "CMU database").
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -63,12 +62,15 @@ TEST_CASE("retarget: matching on the retargeted CMU clips follows the stick on f
             CHECK(m.distance_ratio_to_gait >= 0.9);  // measured 1.03–1.11
             CHECK(m.distance_ratio_to_gait <= 1.2);
             CHECK(m.start_latency_s >= 0.0);
-            CHECK(m.start_latency_s <= 0.35);        // measured 0.046–0.067 s
+            CHECK(m.start_latency_s <= 0.35);        // measured 0.083–0.229 s
             CHECK(m.heading_error_deg <= 10.0);      // measured ≤ 2.0° (−1 on circle: no moving hold)
-            CHECK(m.penetration_mm <= 1.0);          // measured 0
+            CHECK(m.penetration_mm <= 1.0);          // measured ≤ 0.002 mm
+            // Target ≤ 2 mm: measured ≤ 0.35 mm since the pinned reach (a pin is aimed at
+            // through the soft reach's pre-image); 2.1 mm on flat fast_walk before it.
+            CHECK(m.foot_skate_mm <= 2.0);
             CHECK(m.pop_ratio <= 4.0);               // measured 1.24–1.93 (3.7–21.7 with the clip's knee as pole)
-            // Target < 1500 °/s: measured 913–1,364 since the feet-over-risers hold and the
-            // soft reach (920–2,113 before them; 4,939–40,045 with the clip's knee as pole).
+            // Target < 1500 °/s: measured 815–1,495 (920–2,113 before the feet-over-risers
+            // hold and the soft reach; 4,939–40,045 with the clip's knee as pole).
             CHECK(m.max_joint_speed_deg_s < 1500.0);
         }
     }

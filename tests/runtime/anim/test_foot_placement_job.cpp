@@ -10,6 +10,7 @@
 
 #include "runtime/anim/foot_placement.hpp"
 #include "runtime/anim/skeleton.hpp"
+#include "runtime/anim/two_bone_ik.hpp"
 #include "tests/alloc_counter.hpp"
 #include "tests/job_sentinel.hpp"
 
@@ -572,6 +573,63 @@ TEST_CASE("soften_reach: generated targets, unchanged inside, eased short of rea
         CHECK(far > reach - 0.02f * width);
         CHECK(far < reach);
     }
+}
+
+// pinned_reach_target (smooth_feet's pinned reach): generated cases (fixed seed)
+// across its envelope: hips anywhere within 10 m, targets in any direction at
+// 0–1.5× reach, reach 0.3–2 m, width 0 or 0.5–20 % of reach, the IK's soft start
+// 0.9–1. The aim, softened (soften_reach) and solved by the real two-bone IK,
+// puts the ankle on the target within 0.02 mm wherever the target lies within
+// kPinExactReachFraction of the softened range (the pin held exactly); farther,
+// on the same ray, increasing with the target's distance (no jump at the edge).
+TEST_CASE("pinned_reach_target: generated pins, the softened IK lands on them exactly, continuous beyond",
+          "[foot_placement][soft_reach]") {
+    std::uint32_t seed = 4242u;
+    auto next = [&] { seed = seed * 1664525u + 1013904223u; return static_cast<float>(seed >> 8) / 16777216.0f; };
+    auto ankle_for = [](vec3 root, vec3 target, float reach, float width, float soft_start) {
+        TwoBoneIkJob ik;
+        ik.root = root;
+        ik.target = soften_reach(root, pinned_reach_target(root, target, reach, width, soft_start), reach, width);
+        ik.upper_length = ik.lower_length = 0.5f * reach;
+        ik.soft_reach_start = soft_start;
+        TwoBoneIkResult r;
+        ik.result = &r;
+        REQUIRE(ik.run());
+        return r.end;
+    };
+    auto length = [](vec3 v) { return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z); };
+    int exact = 0, beyond = 0;
+    for (int c = 0; c < 3000; ++c) {
+        const vec3 root(20.0f * next() - 10.0f, 20.0f * next() - 10.0f, 20.0f * next() - 10.0f);
+        vec3 dir(2.0f * next() - 1.0f, 2.0f * next() - 1.0f, 2.0f * next() - 1.0f);
+        const float n = length(dir);
+        if (n < 1e-3f) continue;
+        dir = dir / n;
+        const float reach = 0.3f + 1.7f * next();
+        const float width = c % 4 == 0 ? 0.0f : (0.005f + 0.195f * next()) * reach;
+        const float soft_start = 0.9f + 0.1f * next();
+        const float d = 1.5f * reach * next();
+        const vec3 target = root + dir * d;
+        INFO("case " << c << ": reach " << reach << " width " << width << " soft start " << soft_start << " distance " << d);
+        const vec3 ankle = ankle_for(root, target, reach, width, soft_start);
+        const float top = width > 0.0f ? reach * (soft_start + 0.5f * (1.0f - soft_start)) : reach;
+        const float got = length(ankle - root);
+        if (d <= kPinExactReachFraction * top) {
+            ++exact;
+            CHECK(length(ankle - target) <= 2e-5f);
+        } else {
+            ++beyond;
+            const vec3 along = (ankle - root) / got;
+            CHECK(along.x * dir.x + along.y * dir.y + along.z * dir.z > 1.0f - 1e-5f);
+            CHECK(got <= reach + 2e-5f);
+        }
+        // Increasing, and continuous: 0.1 mm farther moves the ankle out by 0 to 0.1 mm.
+        const float farther = length(ankle_for(root, root + dir * (d + 1e-4f), reach, width, soft_start) - root);
+        CHECK(farther >= got - 1e-5f);
+        CHECK(farther <= got + 1e-4f + 2e-5f);
+    }
+    CHECK(exact > 1000);
+    CHECK(beyond > 300);
 }
 
 // reach_drop_needed (smooth_feet's lowering for reach): generated cases (fixed
