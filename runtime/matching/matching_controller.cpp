@@ -118,6 +118,7 @@ void MatchingController::place(MatchingState& s, vec3 position, float heading) c
         for (vec3& v : *a) v = vec3(0.0f);
     s.since_jump = 1e6f;
     s.since_search = 1e6f;  // search at the first tick
+    s.action = -1;
 }
 
 vec3 MatchingController::root_position(const MatchingState& s) const {
@@ -277,6 +278,10 @@ void MatchingController::jump(MatchingState& s, int frame) {
 bool MatchingController::step(MatchingState& s, const MatchingInput& in, LocalPoseOutput out) {
     if (!valid(s, out) || !(in.dt >= 0.0f)) return false;
     s.spring = advance_trajectory(s.spring, in.goal, config_.velocity_halflife_s, config_.facing_halflife_s, in.dt);
+    if (in.action >= 0 && s.action < 0 && static_cast<size_t>(in.action) < db_.action_begin.size()) {
+        jump(s, db_.action_begin[static_cast<size_t>(in.action)]);
+        s.action = in.action;
+    }
     s.frame_time += in.dt * static_cast<float>(db_.frame_rate);
     bool at_end = false;
     while (s.frame_time >= 1.0f) {
@@ -289,16 +294,24 @@ bool MatchingController::step(MatchingState& s, const MatchingInput& in, LocalPo
             // A clip that ends at rest holds its last pose while the stick is at
             // rest (searches still run, that pose the one to beat); else the end
             // forces a jump.
-            at_end = !(goal_at_rest(in.goal) && rests_at_end(db_, s.frame));
+            at_end = s.action >= 0 || !(goal_at_rest(in.goal) && rests_at_end(db_, s.frame));
             break;
         }
     }
     decay_offsets(s, in.dt);
-    correct_root(s, in.dt);
+    const bool acting = s.action >= 0;
+    if (!acting) {
+        correct_root(s, in.dt);
+    } else {
+        // The action's own root motion plays; the stick's spring waits at the root.
+        const vec3 r = root_position(s);
+        s.spring = TrajectorySpring{};
+        s.spring.px = r.x, s.spring.pz = r.z, s.spring.heading = root_heading(s);
+    }
     s.since_search += in.dt;
     s.since_jump += in.dt;
-    const bool due = s.since_search >= config_.search_interval_s;
-    const bool departed = s.since_search >= 0.25f * config_.search_interval_s &&
+    const bool due = !acting && s.since_search >= config_.search_interval_s;
+    const bool departed = !acting && s.since_search >= 0.25f * config_.search_interval_s &&
                           trajectory_departure(s, in.goal) > config_.search_threshold_m;
     if (due || departed || at_end) {
         std::array<float, kMatchFeatureCount> raw{}, query{};
@@ -320,6 +333,7 @@ bool MatchingController::step(MatchingState& s, const MatchingInput& in, LocalPo
         const bool behind = best.frame < s.frame && s.frame - best.frame <= kNearFrames && goal_at_rest(in.goal);
         const bool near = same_clip && (ahead || behind);
         if (best.frame >= 0 && best.frame != s.frame && !near) jump(s, best.frame);
+        s.action = -1;  // an action ends at its clip's end, back in the locomotion
     }
     const size_t sf = static_cast<size_t>(db_.source_frame[static_cast<size_t>(s.frame)]);
     s.contacts = source_.contacts[s.frame_time < 0.5f || s.frame + 1 >= db_.clip_end[static_cast<size_t>(s.frame)] ? sf : sf + 1];

@@ -17,7 +17,12 @@
 //     shown and the new frame (per joint a rotation vector and a translation) and
 //     the offsets' velocities (the shown pose's velocity − the new frame's) decay
 //     to zero as critically damped springs of halflife `inertialization_s` / 3,
-//     so neither the pose nor its velocity jumps.
+//     so neither the pose nor its velocity jumps;
+//   - an action (MatchingInput::action: a button's labelled clip, which the
+//     motion graph supplies) is entered by such a jump to its first frame and
+//     played to its end with its own root motion (no search, no correction
+//     toward the stick's spring, which waits at the root); at its end a search
+//     jumps back into the locomotion, inertialized the same way.
 // The state is plain fixed-size data (it lives in PuppetState and is hashed);
 // the controller holds the database and its scratch, sized at construction, so
 // step() never allocates.
@@ -54,6 +59,8 @@ struct MatchingState {
     float since_jump = 1e6f;         // seconds since the last jump (offsets are zero from 4 × inertialization_s)
     float last_cost = 0.0f;          // cost of the last search's answer
     std::uint8_t contacts = 0;       // foot contacts of the frame played
+    std::int32_t action = -1;        // the action clip playing (database action index), −1: locomotion
+    std::uint16_t held_buttons = 0;  // the pad's buttons last tick (the caller's, for presses)
     std::int64_t searches = 0, jumps = 0;
     // Pose shown = exp(offset_rotation) · frame's rotation (a rotation vector, radians,
     // in the joint's parent frame; the root's in the world), frame's translation +
@@ -67,6 +74,9 @@ struct MatchingState {
 struct MatchingInput {
     TrajectoryGoal goal{};          // desired velocity (world m/s) and facing
     float dt = 0.0f;
+    // Start this action clip (an index into the database's action_begin) this
+    // tick; −1, an index out of range or an action already playing: none.
+    std::int32_t action = -1;
 };
 
 class MatchingController {

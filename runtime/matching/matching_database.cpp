@@ -75,9 +75,11 @@ Outcome check_source(const MatchingSource& s, const MatchingWeights& w) {
         s.contacts.size() != frames)
         return Outcome::failure("matching database: rotations, translations and contacts disagree on the frame count");
     if (s.clips.empty()) return Outcome::failure("matching database: no clips to match");
-    for (const MatchingClipRange& c : s.clips)
-        if (c.first_frame < 0 || c.frame_count < 2 || static_cast<size_t>(c.first_frame) + static_cast<size_t>(c.frame_count) > frames)
-            return Outcome::failure("matching database: a clip range lies outside the frames or has under 2 frames");
+    for (std::span<const MatchingClipRange> ranges : {s.clips, s.actions})
+        for (const MatchingClipRange& c : ranges)
+            if (c.first_frame < 0 || c.frame_count < 2 ||
+                static_cast<size_t>(c.first_frame) + static_cast<size_t>(c.frame_count) > frames)
+                return Outcome::failure("matching database: a clip range lies outside the frames or has under 2 frames");
     for (int g = 0; g < kMatchGroupCount; ++g)
         if (!(w.of(g) >= 0.0f) || !std::isfinite(w.of(g)))
             return Outcome::failure("matching database: feature weights must be finite and not negative");
@@ -194,21 +196,23 @@ void build_search_layout(MatchingDatabase& db) {
 void normalise_matching_database(MatchingDatabase& db, const MatchingWeights& weights) {
     const size_t frames = static_cast<size_t>(db.frame_count);
     // Mean per feature, then one standard deviation per group (the root of the
-    // mean variance of its features), in frame order with double sums.
+    // mean variance of its features), in frame order with double sums, over the
+    // matched clips' frames (actions follow them and do not move the scales).
+    const size_t stats = db.matched_frames > 0 && db.matched_frames <= db.frame_count ? static_cast<size_t>(db.matched_frames) : frames;
     std::array<double, kMatchFeatureCount> sum{};
-    for (size_t f = 0; f < frames; ++f)
+    for (size_t f = 0; f < stats; ++f)
         for (size_t k = 0; k < kMatchFeatureCount; ++k) sum[k] += db.raw_features[f * kMatchFeatureCount + k];
-    for (size_t k = 0; k < kMatchFeatureCount; ++k) db.mean[k] = frames ? static_cast<float>(sum[k] / static_cast<double>(frames)) : 0.0f;
+    for (size_t k = 0; k < kMatchFeatureCount; ++k) db.mean[k] = stats ? static_cast<float>(sum[k] / static_cast<double>(stats)) : 0.0f;
     for (int g = 0; g < kMatchGroupCount; ++g) {
         const size_t b = static_cast<size_t>(kMatchGroupBegin[static_cast<size_t>(g)]);
         const size_t e = static_cast<size_t>(kMatchGroupBegin[static_cast<size_t>(g) + 1]);
         double var = 0.0;
-        for (size_t f = 0; f < frames; ++f)
+        for (size_t f = 0; f < stats; ++f)
             for (size_t k = b; k < e; ++k) {
                 const double d = static_cast<double>(db.raw_features[f * kMatchFeatureCount + k]) - db.mean[k];
                 var += d * d;
             }
-        const double count = static_cast<double>(frames) * static_cast<double>(e - b);
+        const double count = static_cast<double>(stats) * static_cast<double>(e - b);
         const double sd = count > 0.0 ? std::sqrt(var / count) : 0.0;
         const double scale = sd > 1e-6 ? 1.0 / sd : 1.0;  // a constant group is compared in its own units
         for (size_t k = b; k < e; ++k) db.inv_scale[k] = static_cast<float>(scale * weights.of(g));
@@ -234,16 +238,20 @@ Outcome build_matching_database(const MatchingSource& s, const MatchingWeights& 
     std::vector<vec3> pos(static_cast<size_t>(db.joint_count));
     std::vector<FrameBody> body;
     std::vector<std::int32_t> clip_begin;
-    for (const MatchingClipRange& c : s.clips) {
+    auto add_clip = [&](const MatchingClipRange& c, bool searchable) {
         const std::int32_t begin = static_cast<std::int32_t>(db.source_frame.size());
         for (std::int32_t i = 0; i < c.frame_count; ++i) {
             db.source_frame.push_back(c.first_frame + i);
             db.clip_end.push_back(begin + c.frame_count);
             clip_begin.push_back(begin);
-            db.searchable.push_back(i + margin < c.frame_count ? 1 : 0);
+            db.searchable.push_back(searchable && i + margin < c.frame_count ? 1 : 0);
             body.push_back(body_of(s, c.first_frame + i, rot, pos));
         }
-    }
+        return begin;
+    };
+    for (const MatchingClipRange& c : s.clips) add_clip(c, true);
+    db.matched_frames = static_cast<std::int32_t>(db.source_frame.size());
+    for (const MatchingClipRange& c : s.actions) db.action_begin.push_back(add_clip(c, false));
     db.frame_count = static_cast<std::int32_t>(db.source_frame.size());
     db.raw_features.assign(static_cast<size_t>(db.frame_count) * kMatchFeatureCount, 0.0f);
     for (std::int32_t f = 0; f < db.frame_count; ++f) {

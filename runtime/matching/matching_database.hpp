@@ -74,6 +74,10 @@ struct MatchingSource {
     std::span<const vec3> translations;           // same layout, source units
     std::span<const std::uint8_t> contacts;       // per frame: bit 0 left foot, bit 1 right foot
     std::span<const MatchingClipRange> clips;     // the clips that enter the database, in order
+    // Action clips (a button's labelled clip): in the database after `clips`,
+    // played only on request (MatchingInput::action), never a search answer,
+    // and not in the statistics the features are normalised by.
+    std::span<const MatchingClipRange> actions;
     double frame_rate = 30.0;
     float metres_per_unit = 1.0f;
     double facing_offset = 0.0;                   // yaw from the root's +Z to the clips' forward
@@ -89,6 +93,8 @@ struct MatchingDatabase {
     std::vector<std::int32_t> source_frame;      // database frame → source frame
     std::vector<std::int32_t> clip_end;          // database frame → one past its clip's last database frame
     std::vector<std::uint8_t> searchable;        // 1: a search may jump here (enough clip left)
+    std::int32_t matched_frames = 0;             // frames of the source's clips: [0, matched_frames); actions follow
+    std::vector<std::int32_t> action_begin;      // database frame where each action clip starts
     std::vector<float> features;                 // [frame * kMatchFeatureCount + k], normalised and weighted
     std::vector<float> raw_features;             // the same before normalisation (metres, m/s, unit facings)
     std::array<float, kMatchFeatureCount> mean{};
@@ -116,7 +122,8 @@ struct MatchingDatabase {
     void normalise(std::span<const float> raw, std::span<float> out) const;
 };
 
-// The features of every frame of `source`'s clips, normalised with `weights`.
+// The features of every frame of `source`'s clips and actions, normalised with
+// `weights` by the clips' statistics.
 // Fails (naming what is wrong) for an empty or inconsistent source, a foot joint
 // missing, a weight that is negative or not finite, or a feature that is not finite.
 Outcome build_matching_database(const MatchingSource& source, const MatchingWeights& weights, MatchingDatabase& out);

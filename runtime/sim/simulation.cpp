@@ -113,7 +113,7 @@ void hash_graph(HashBytes& h, std::int32_t source, const GraphControllerState& g
 }
 // The matching controller's state and its feet, field by field.
 void hash_matching(HashBytes& h, const MatchingState& m, const FootPlacementState& feet, size_t joints) {
-    hash_ints(h, {m.frame, m.contacts, feet.started, feet.feet[0].contact, feet.feet[1].contact});
+    hash_ints(h, {m.frame, m.contacts, feet.started, feet.feet[0].contact, feet.feet[1].contact, m.action, m.held_buttons});
     const double world[3] = {m.world_angle, m.world_dx, m.world_dz};
     h.add(world, sizeof world);
     const TrajectorySpring& sp = m.spring;
@@ -591,14 +591,25 @@ void Simulation::attach_matching() {
     for (const char* label : {"walk", "run", "idle", "turn", "stop"})
         if (const int b = g.label_index(label); b >= 0) locomotion |= 1u << b;
     matching_clips_.clear();
-    for (const GraphClip& c : g.clips)
-        if (locomotion == 0 || (c.label_mask & locomotion) != 0) matching_clips_.push_back({c.first_frame, c.frame_count});
+    matching_actions_.clear();
+    matching_action_of_label_.assign(g.labels.size(), -1);
+    for (const GraphClip& c : g.clips) {
+        if (locomotion == 0 || (c.label_mask & locomotion) != 0) {
+            matching_clips_.push_back({c.first_frame, c.frame_count});
+        } else if (c.label_mask != 0 && c.frame_count >= 2) {
+            for (size_t b = 0; b < matching_action_of_label_.size(); ++b)
+                if (((c.label_mask >> b) & 1u) && matching_action_of_label_[b] < 0)
+                    matching_action_of_label_[b] = static_cast<std::int32_t>(matching_actions_.size());
+            matching_actions_.push_back({c.first_frame, c.frame_count});
+        }
+    }
     MatchingSource source;
     source.parents = std::span<const int>(g.skeleton.parents);
     source.rotations = g.rotations;
     source.translations = g.translations;
     source.contacts = g.contacts;
     source.clips = matching_clips_;
+    source.actions = matching_actions_;
     source.frame_rate = g.frame_rate;
     source.metres_per_unit = metres_per_unit_;
     source.facing_offset = graph_controller_->facing_offset();
@@ -621,6 +632,18 @@ void Simulation::step_matching(const TickInput& input, float dt, Pose& out) {
     MatchingInput in;
     in.dt = dt;
     in.goal.heading = s.matching.spring.heading;
+    // A newly pressed button mapped to a label with an action clip plays it
+    // (the graph's [motion_graph.buttons] map, as in graph mode).
+    const std::uint16_t pressed = static_cast<std::uint16_t>(input.buttons & ~s.matching.held_buttons);
+    if (dt > 0.0f) s.matching.held_buttons = static_cast<std::uint16_t>(input.buttons);
+    const GraphControllerConfig& graph_config = graph_controller_->config();
+    for (int b = 0; b < kGraphActionButtons && pressed != 0 && dt > 0.0f; ++b) {
+        const int label = graph_config.button_label[static_cast<size_t>(b)];
+        if (!((pressed >> b) & 1u) || label < 0 || static_cast<size_t>(label) >= matching_action_of_label_.size()) continue;
+        if (matching_action_of_label_[static_cast<size_t>(label)] < 0) continue;
+        in.action = matching_action_of_label_[static_cast<size_t>(label)];
+        break;
+    }
     if (fraction > 0.0f) {
         const float dx = sx / length, dz = -sy / length;
         in.goal.heading = static_cast<float>(det::atan2(dx, dz));

@@ -162,6 +162,10 @@ private:
     bool graph_matches_puppet_ = false;
     bool skeleton_from_graph_ = false;
     std::vector<MatchingClipRange> matching_clips_;
+    // Matching's actions: the graph's clips with no locomotion label, and per
+    // graph label the first such clip carrying it (−1: none), for the buttons.
+    std::vector<MatchingClipRange> matching_actions_;
+    std::vector<std::int32_t> matching_action_of_label_;
     std::unique_ptr<MatchingDatabase> matching_db_;
     std::unique_ptr<MatchingController> matching_;
     Pose gait_pose_, graph_pose_, feet_pose_, blend_pose_, matching_pose_, matching_feet_pose_;  // scratch, rebuilt from the state every tick

@@ -11,6 +11,9 @@
 #include "app/eval/gait_eval.hpp"
 #include "app/config/program_source.hpp"
 #include "app/config/terrain_file.hpp"
+#include "app/graph/graph_files.hpp"
+#include "runtime/sim/tick_input.hpp"
+#include "tests/test_support.hpp"
 #include "runtime/sim/simulation.hpp"
 
 using namespace marionette;
@@ -154,4 +157,72 @@ TEST_CASE("gait-eval: matching's joint speed stays under the limit where pin rel
     CHECK(stairs.max_joint_speed_deg_s < 1500.0);
     CHECK(stairs.penetration_mm <= 1.0);
     CHECK(stairs.foot_skate_mm <= 2.0);
+}
+
+// Matching's actions (issue #14): the graph stays the sequencer of actions. On
+// the default graph, each of the four mapped buttons ([motion_graph.buttons]:
+// south jump, east wave, west bow, north look_around), pressed while walking or
+// standing, plays that label's clip from its first frame to its end (the
+// state's action index set for the clip's length at 240 Hz, ±1 frame), a press
+// while it plays starts nothing new, and matching then resumes (no action, a
+// locomotion frame). Then the shipped actions.prog (all four buttons, walking
+// and standing) on flat and stairs keeps the issue's limits: joint speed
+// < 1500 °/s, penetration ≤ 1 mm, skate ≤ 2 mm, pop ratio ≤ 4.
+TEST_CASE("gait-eval: matching plays each action button's graph clip through and resumes, within the limits",
+          "[gait_eval][matching][action]") {
+    set_simulation_float_mode();
+    const AppConfig shipped = default_config();
+    SimConfig config = shipped.sim;
+    config.motion_source = MotionSourceSetting::matching;
+    config.terrain_name = "flat";
+    config.terrain = load_terrain("flat");
+    const auto graph = std::make_shared<const MotionGraph>(build_default_motion_graph(config, shipped.graph_build));
+    const char* labels[] = {"jump", "wave", "bow", "look_around"};
+    const Button buttons[] = {Button::south, Button::east, Button::west, Button::north};
+    for (int a = 0; a < 4; ++a) {
+        for (const bool walking : {true, false}) {
+            INFO(labels[a] << (walking ? " while walking" : " standing"));
+            const int label = graph->label_index(labels[a]);
+            REQUIRE(label >= 0);
+            int clip_frames = -1;
+            for (const GraphClip& c : graph->clips)
+                if (((c.label_mask >> label) & 1u) && clip_frames < 0) clip_frames = c.frame_count;
+            REQUIRE(clip_frames > 1);
+            Simulation sim(config);
+            attach_motion_graph(sim, graph, "default");
+            TickInput in;
+            in.left_y = walking ? static_cast<std::int16_t>(-0.6 * 32767) : 0;
+            for (int tick = 0; tick < 480; ++tick) sim.step(in);
+            REQUIRE(sim.state().matching.action == -1);
+            int acting = 0, started = -1, ended = -1;
+            for (int tick = 0; tick < 240 * 8; ++tick) {
+                // Pressed for 3 ticks, then again 0.5 s later while the action plays.
+                in.buttons = (tick < 3 || (tick >= 120 && tick < 123)) ? button_bit(buttons[a]) : 0u;
+                sim.step(in);
+                const std::int32_t action = sim.state().matching.action;
+                if (action >= 0 && started < 0) started = tick;
+                if (action < 0 && started >= 0 && ended < 0) ended = tick;
+                acting += action >= 0 ? 1 : 0;
+            }
+            CHECK(started == 0);
+            const double expected = (clip_frames - 1) * 240.0 / graph->frame_rate;
+            CHECK(ended - started == acting);  // one action, not restarted by the second press
+            CHECK(std::fabs(acting - expected) <= 240.0 / graph->frame_rate + 1.0);
+            CHECK(sim.state().matching.action == -1);
+            const MatchingDatabase* db = sim.matching_database();
+            REQUIRE(db != nullptr);
+            CHECK(sim.state().matching.frame < db->matched_frames);
+        }
+    }
+    for (const char* terrain : {"flat", "stairs"}) {
+        INFO("actions.prog on " << terrain);
+        config.terrain_name = terrain;
+        config.terrain = load_terrain(terrain);
+        const GaitMetrics m = evaluate_gait(config, load_program(test::source_path("config/programs/actions.prog")), {}, graph);
+        CHECK(m.motion_source == "matching");
+        CHECK(m.max_joint_speed_deg_s < 1500.0);
+        CHECK(m.penetration_mm <= 1.0);
+        CHECK(m.foot_skate_mm <= 2.0);
+        CHECK(m.pop_ratio <= 4.0);
+    }
 }

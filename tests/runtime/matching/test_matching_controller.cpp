@@ -3,6 +3,7 @@
 // never jumps), stays deterministic, and never allocates in step().
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 #include "runtime/matching/matching_controller.hpp"
@@ -152,4 +153,108 @@ TEST_CASE("matching controller: a jump adds no joint-speed spike beyond the clip
     CHECK(jumps > 100);
     CHECK(worst_speed <= 1.05 * clip_speed);
     CHECK(worst_jump_step <= 1.5 * worst_steady_step);
+}
+
+// Actions (a button's labelled clip, issue #14): a squat clip, in place, is
+// added to the synthetic database as an action. It is in the database but
+// never a search answer, and it leaves the locomotion's features bit for bit
+// as they were. Requested while walking, it plays from its first frame to its
+// end with its own root motion (the root stays put), a second request while it
+// plays and an index out of range do nothing, then a search takes the puppet
+// back into the locomotion, which follows the stick again. Entry and exit are
+// inertialized: no joint's speed steps at them by more than 1.5× the largest
+// step elsewhere; nothing allocates.
+TEST_CASE("matching controller: an action clip plays on request, entered and left without pops, then matching resumes",
+          "[matching][action]") {
+    test::MatchingFixture fixture = test::make_matching_fixture(24, 120, 3);
+    const std::int32_t action_first = static_cast<std::int32_t>(fixture.contacts.size());
+    const int action_frames = 60;  // 2 s at 30 Hz
+    for (int f = 0; f < action_frames; ++f) {
+        const double a = 0.6 * det::sin(3.141592653589793 * f / (action_frames - 1));
+        fixture.rotations.push_back(quat_identity());
+        fixture.translations.push_back(vec3(0.0f, static_cast<float>(0.9 - 0.2 * a), 0.0f));
+        for (int leg = 0; leg < 2; ++leg) {
+            fixture.rotations.push_back(quat_axis_angle(vec3(1.0f, 0.0f, 0.0f), -a));
+            fixture.translations.push_back(vec3(leg == 0 ? 0.1f : -0.1f, 0.0f, 0.0f));
+            fixture.rotations.push_back(quat_axis_angle(vec3(1.0f, 0.0f, 0.0f), 2.0 * a));
+            fixture.translations.push_back(vec3(0.0f, -0.45f, 0.0f));
+            fixture.rotations.push_back(quat_identity());
+            fixture.translations.push_back(vec3(0.0f, -0.42f, 0.0f));
+        }
+        fixture.contacts.push_back(3);
+    }
+    const std::vector<MatchingClipRange> actions{{action_first, action_frames}};
+    MatchingSource source = fixture.source();
+    MatchingDatabase plain;
+    REQUIRE(build_matching_database(source, {}, plain).ok());
+    source.actions = actions;
+    MatchingDatabase db;
+    REQUIRE(build_matching_database(source, {}, db).ok());
+    REQUIRE(db.action_begin.size() == 1);
+    CHECK(db.matched_frames == plain.frame_count);
+    CHECK(db.action_begin[0] == plain.frame_count);
+    CHECK(db.frame_count == plain.frame_count + action_frames);
+    for (int f = db.action_begin[0]; f < db.frame_count; ++f) CHECK(db.searchable[static_cast<size_t>(f)] == 0);
+    CHECK(std::equal(plain.features.begin(), plain.features.end(), db.features.begin()));
+    CHECK(plain.mean == db.mean);
+    CHECK(plain.inv_scale == db.inv_scale);
+
+    MatchingController mc(source, db, {});
+    const float dt = 1.0f / 240.0f;
+    const size_t n = 7;
+    MatchingState s = mc.initial_state(vec3(0.0f), 0.0f);
+    std::array<quat, 7> r{}, previous{};
+    std::array<vec3, 7> t{};
+    std::array<double, 7> previous_speed{};
+    MatchingInput in;
+    in.dt = dt;
+    in.goal = goal_of(1.2, 0.4);
+    double worst_edge_step = 0.0, worst_steady_step = 0.0;
+    int entered = -1, left = -1, first_bad_tick = -1, acting_ticks = 0;
+    vec3 root_at_entry{}, after_start{};
+    const std::uint64_t allocations = test::allocation_count();
+    for (int tick = 0; tick < 240 * 7; ++tick) {
+        in.action = tick == 240 ? 0 : (tick == 300 ? 0 : (tick == 310 ? 5 : -1));
+        const bool was_acting = s.action >= 0;
+        REQUIRE(mc.step(s, in, {r, t}));
+        const bool acting = s.action >= 0;
+        if (acting && !was_acting) entered = tick, root_at_entry = mc.root_position(s);
+        if (!acting && was_acting) left = tick;
+        if (acting) {
+            // Checked after the loop (Catch's messages allocate).
+            const vec3 p = mc.root_position(s);
+            const bool in_clip = s.frame >= db.action_begin[0] && s.frame < db.frame_count;
+            const bool put = std::fabs(p.x - root_at_entry.x) < 1e-4f && std::fabs(p.z - root_at_entry.z) < 1e-4f;  // the squat's root stays put
+            if ((!in_clip || !put) && first_bad_tick < 0) first_bad_tick = tick;
+            ++acting_ticks;
+        }
+        if (left >= 0 && tick == left + 240) after_start = mc.root_position(s);
+        if (tick >= 2) {
+            const bool edge = acting != was_acting;
+            for (size_t j = 1; j < n; ++j) {
+                const double speed = quat_angle_between(previous[j], r[j]) / dt;
+                double& worst = edge ? worst_edge_step : worst_steady_step;
+                worst = std::max(worst, std::fabs(speed - previous_speed[j]));
+                previous_speed[j] = speed;
+            }
+        }
+        previous = r;
+    }
+    CHECK(test::allocation_count() == allocations);
+    CHECK(first_bad_tick == -1);
+    CHECK(acting_ticks == left - entered);
+    CHECK(entered == 240);
+    // The clip's 59 frame intervals at 30 Hz: 472 ticks, give or take the frame the end lands on.
+    CHECK(left - entered >= 468);
+    CHECK(left - entered <= 480);
+    CHECK(s.action == -1);
+    CHECK(s.frame < db.matched_frames);
+    INFO("speed step at entry/exit " << worst_edge_step << ", elsewhere " << worst_steady_step << " rad/s per tick");
+    CHECK(worst_edge_step <= 1.5 * worst_steady_step);
+    // Back in the locomotion it follows the stick: 1.2 m/s over the last 2 s, facing 0.4 rad.
+    const vec3 end = mc.root_position(s);
+    const double covered = std::sqrt((end.x - after_start.x) * (end.x - after_start.x) + (end.z - after_start.z) * (end.z - after_start.z));
+    const double seconds = (240.0 * 7 - 1 - (left + 240)) / 240.0;
+    CHECK(covered == Approx(1.2 * seconds).epsilon(0.1));
+    CHECK(std::fabs(det::wrap_angle(mc.root_heading(s) - 0.4)) < 0.2);
 }
