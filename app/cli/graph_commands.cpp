@@ -22,6 +22,7 @@
 #include "app/graph/graph_rebuild.hpp"
 #include "app/io/json.hpp"
 #include "graph_builder/graph_builder.hpp"
+#include "runtime/graph/graph_path.hpp"
 #include "render_es/image.hpp"
 #include "runtime/formats/bvh.hpp"
 #include "runtime/gait/puppet.hpp"
@@ -308,7 +309,16 @@ int graph_info_command(const GraphInfoOptions& o) {
     const MotionGraph g = load_motion_graph_file(o.graph_file);
     const double load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     int transitions = 0;
-    for (const GraphEdge& e : g.edges) transitions += e.kind == GraphEdgeKind::transition;
+    // The transitions' registration (transition_time_warp): DTW path costs
+    // summed over every transition, warped against the plain blend's diagonal.
+    double warped = 0.0, diagonal = 0.0;
+    for (const GraphEdge& e : g.edges) {
+        transitions += e.kind == GraphEdgeKind::transition;
+        double w = 0.0, d = 0.0;
+        transition_warp_costs(g, e, w, d);
+        warped += w, diagonal += d;
+    }
+    const double warp_ratio = diagonal > 0.0 ? warped / diagonal : 1.0;
     const std::vector<std::string> kept = kept_clip_names(g);
     if (o.json) {
         std::string clips, labels, kept_json;
@@ -321,18 +331,20 @@ int graph_info_command(const GraphInfoOptions& o) {
         fmt::print("{{\"file\":{},\"version\":{},\"source_hash\":\"{:016x}\",\"joints\":{},\"frame_rate\":{},"
                    "\"window_frames\":{},\"frames\":{},\"nodes\":{},\"edges\":{},\"transitions\":{},"
                    "\"nodes_before\":{},\"edges_before\":{},\"candidates\":{},\"threshold\":{},\"frames_kept_pct\":{},"
-                   "\"labels\":[{}],\"clips_kept\":[{}],\"clips\":[{}],\"load_ms\":{}}}\n",
+                   "\"labels\":[{}],\"clips_kept\":[{}],\"clips\":[{}],\"transition_warp_cost_ratio\":{},\"load_ms\":{}}}\n",
                    json::quote(o.graph_file), kMotionGraphVersion, g.source_hash, g.joint_count(),
                    json::number(g.frame_rate), g.window_frames, g.contacts.size(), g.nodes.size(), g.edges.size(),
                    transitions, g.stats.nodes_before, g.stats.edges_before, g.stats.candidates,
                    json::number(g.stats.threshold),
                    json::number(g.stats.frames > 0 ? 100.0 * static_cast<double>(g.stats.frames_kept) / g.stats.frames : 0.0),
-                   labels, kept_json, clips, json::number(load_ms));
+                   labels, kept_json, clips, json::number(warp_ratio), json::number(load_ms));
     } else {
         fmt::print("{}: motion graph v{}, {} joints, {} frames at {} Hz, k = {}\n", o.graph_file, kMotionGraphVersion,
                    g.joint_count(), g.contacts.size(), g.frame_rate, g.window_frames);
         fmt::print("{} nodes, {} edges ({} transitions); before pruning {} nodes, {} edges\n", g.nodes.size(),
                    g.edges.size(), transitions, g.stats.nodes_before, g.stats.edges_before);
+        fmt::print("transitions registered by time warping: pose distance {:.1f} % of the plain blend's\n",
+                   100.0 * warp_ratio);
         fmt::print("labels: {}\nclips kept: {}\nloaded in {:.2f} ms\n", fmt::join(g.labels, " "), fmt::join(kept, " "),
                    load_ms);
     }

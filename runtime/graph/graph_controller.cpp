@@ -123,6 +123,11 @@ GraphController::GraphController(const MotionGraph& graph, const GraphController
     frame_yaw_.resize(frames);
     const int root = root_joint_of(graph);
     facing_offset_ = estimate_graph_facing(graph);
+    // Every transition's registration (time warp), once: the tick only reads it.
+    const size_t width = 2 * static_cast<size_t>(graph.window_frames);
+    transition_warps_.assign(graph.edges.size() * width, 0.0f);
+    for (size_t e = 0; e < graph.edges.size(); ++e)
+        transition_time_warp(graph, graph.edges[e], std::span<float>(transition_warps_).subspan(e * width, width));
     for (size_t f = 0; f < frames; ++f) {
         const vec3 forward = quat_rotate(graph.rotations[f * joints + static_cast<size_t>(root)], vec3(0.0f, 0.0f, 1.0f));
         frame_yaw_[f] = static_cast<float>(det::wrap_angle(det::atan2(forward.x, forward.z) + facing_offset_));
@@ -189,7 +194,7 @@ double GraphController::root_heading(int node, const PlanarTransform& world) con
 
 GraphSampleJob GraphController::sample_job(const GraphControllerState& s, LocalPoseOutput pose) {
     return {&graph_, s.edge, s.edge_position, placement(s.world_angle, s.world_dx, s.world_dz),
-            {sample_rotations_, sample_translations_}, pose};
+            {sample_rotations_, sample_translations_}, pose, transition_warps_};
 }
 
 bool GraphController::pose(const GraphControllerState& s, LocalPoseOutput pose) { return sample_job(s, pose).run(); }

@@ -162,6 +162,7 @@ private:
 
     const MotionGraph& graph_;
     GraphControllerConfig config_;
+    std::vector<float> transition_warps_;  // per edge 2·window_frames registered times (graph_sample.hpp)
     GraphPathSearch path_search_;  // the action query's scratch (see the top of this file)
     std::int32_t path_search_label_ = -1;  // label path_search_ is searching for, −1: none yet
     std::vector<quat> sample_rotations_;  // GraphSampleJob's scratch

@@ -1,7 +1,10 @@
 #include "runtime/graph/graph_path.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
+#include <utility>
+#include <vector>
 
 namespace marionette {
 
@@ -188,20 +191,141 @@ void graph_frame_pose(const MotionGraph& g, int global_frame, const PlanarTransf
     }
 }
 
-std::uint8_t graph_transition_pose(const MotionGraph& g, const GraphEdge& e, int p, const PlanarTransform& world,
-                                   std::span<quat> rotations, std::span<vec3> translations) {
+namespace {
+// Window time `time` (frames from `first`, ≥ 0, ≤ k − 1) of joint j: the two
+// neighbouring frames slerped / lerped (one frame when the time is whole).
+void window_sample(const MotionGraph& g, int first, float time, size_t j, quat& q, vec3& t) {
+    const size_t joints = static_cast<size_t>(g.joint_count());
+    const int whole = static_cast<int>(time);
+    const float u = time - static_cast<float>(whole);
+    const size_t base = static_cast<size_t>(first + whole) * joints + j;
+    q = g.rotations[base];
+    t = g.translations[base];
+    if (u > 0.0f) {
+        q = quat_slerp(q, g.rotations[base + joints], u);
+        t = lerp(t, g.translations[base + joints], u);
+    }
+}
+
+// First global frames of a transition's source and target windows.
+void transition_windows(const MotionGraph& g, const GraphEdge& e, int& first_a, int& first_b) {
     const GraphNode& a = g.nodes[static_cast<size_t>(e.from)];
     const GraphNode& b = g.nodes[static_cast<size_t>(e.to)];
-    const int fa = g.clips[static_cast<size_t>(a.clip)].first_frame + a.frame + p;
-    const int fb = g.clips[static_cast<size_t>(b.clip)].first_frame + b.frame - g.window_frames + p;
-    const PlanarTransform world_b = compose_planar(world, edge_alignment(e));
-    const float alpha = transition_weight(p, g.window_frames);
+    first_a = g.clips[static_cast<size_t>(a.clip)].first_frame + a.frame;
+    first_b = g.clips[static_cast<size_t>(b.clip)].first_frame + b.frame - g.window_frames;
+}
+
+// The DTW of a transition's windows: the k × k accumulated costs (row-major,
+// +inf outside the band) and the path from (0, 0) to (k − 1, k − 1).
+struct WarpPath {
+    std::vector<double> cost, total;
+    std::vector<std::pair<int, int>> path;
+};
+WarpPath warp_path(const MotionGraph& g, const GraphEdge& e) {
+    const int k = g.window_frames;
+    int first_a = 0, first_b = 0;
+    transition_windows(g, e, first_a, first_b);
     const size_t joints = static_cast<size_t>(g.joint_count());
-    const size_t base_a = static_cast<size_t>(fa) * joints, base_b = static_cast<size_t>(fb) * joints;
+    const int band = std::max(1, static_cast<int>(kWarpBandFraction * k));
+    WarpPath w;
+    const double inf = std::numeric_limits<double>::infinity();
+    w.cost.assign(static_cast<size_t>(k * k), inf);
+    w.total.assign(static_cast<size_t>(k * k), inf);
+    auto at = [k](int i, int j) { return static_cast<size_t>(i * k + j); };
+    for (int i = 0; i < k; ++i)
+        for (int j = std::max(0, i - band); j <= std::min(k - 1, i + band); ++j) {
+            const size_t ba = static_cast<size_t>(first_a + i) * joints, bb = static_cast<size_t>(first_b + j) * joints;
+            double d = 0.0;
+            for (size_t q = 0; q < joints; ++q) {
+                if (g.skeleton.parents[q] == kNoParent) continue;
+                const quat qa = g.rotations[ba + q], qb = g.rotations[bb + q];
+                const double dot = static_cast<double>(qa.w) * qb.w + static_cast<double>(qa.x) * qb.x +
+                                   static_cast<double>(qa.y) * qb.y + static_cast<double>(qa.z) * qb.z;
+                d += 1.0 - std::fabs(dot);
+            }
+            w.cost[at(i, j)] = d;
+            double best = i == 0 && j == 0 ? 0.0 : inf;
+            if (i > 0 && j > 0) best = std::min(best, w.total[at(i - 1, j - 1)]);
+            if (i > 0) best = std::min(best, w.total[at(i - 1, j)]);
+            if (j > 0) best = std::min(best, w.total[at(i, j - 1)]);
+            w.total[at(i, j)] = d + best;
+        }
+    // Back from the end: the diagonal on a tie, then advancing the source.
+    int i = k - 1, j = k - 1;
+    w.path.push_back({i, j});
+    while (i > 0 || j > 0) {
+        const double diag = i > 0 && j > 0 ? w.total[at(i - 1, j - 1)] : inf;
+        const double up = i > 0 ? w.total[at(i - 1, j)] : inf;
+        const double left = j > 0 ? w.total[at(i, j - 1)] : inf;
+        if (diag <= up && diag <= left) --i, --j;
+        else if (up <= left) --i;
+        else --j;
+        w.path.push_back({i, j});
+    }
+    std::reverse(w.path.begin(), w.path.end());
+    return w;
+}
+}  // namespace
+
+void transition_time_warp(const MotionGraph& g, const GraphEdge& e, std::span<float> out) {
+    const int k = g.window_frames;
+    if (out.size() != static_cast<size_t>(2 * k)) return;
+    for (int p = 0; p < k; ++p) out[static_cast<size_t>(p)] = out[static_cast<size_t>(k + p)] = static_cast<float>(p);
+    if (e.kind != GraphEdgeKind::transition || k < 3 || e.frames != k) return;
+    const WarpPath w = warp_path(g, e);
+    const int last = static_cast<int>(w.path.size()) - 1;
+    std::vector<double> a(static_cast<size_t>(k)), b(static_cast<size_t>(k));
+    for (int p = 0; p < k; ++p) {
+        // Resampled by position along the path (its points evenly spaced).
+        const double s = static_cast<double>(p) * last / (k - 1);
+        const int idx = std::min(static_cast<int>(s), last - 1 < 0 ? 0 : last - 1);
+        const double u = last > 0 ? s - idx : 0.0;
+        const auto& p0 = w.path[static_cast<size_t>(idx)];
+        const auto& p1 = w.path[static_cast<size_t>(last > 0 ? idx + 1 : idx)];
+        a[static_cast<size_t>(p)] = p0.first + (p1.first - p0.first) * u;
+        b[static_cast<size_t>(p)] = p0.second + (p1.second - p0.second) * u;
+    }
+    for (int pass = 0; pass < 2; ++pass)
+        for (std::vector<double>* v : {&a, &b}) {
+            std::vector<double> smooth = *v;
+            for (int p = 1; p + 1 < k; ++p)
+                smooth[static_cast<size_t>(p)] = 0.25 * (*v)[static_cast<size_t>(p - 1)] + 0.5 * (*v)[static_cast<size_t>(p)] +
+                                                 0.25 * (*v)[static_cast<size_t>(p + 1)];
+            *v = smooth;
+        }
+    for (int p = 0; p < k; ++p) {
+        out[static_cast<size_t>(p)] = static_cast<float>(std::min(a[static_cast<size_t>(p)], static_cast<double>(k - 1)));
+        out[static_cast<size_t>(k + p)] = static_cast<float>(std::min(b[static_cast<size_t>(p)], static_cast<double>(k - 1)));
+    }
+}
+
+void transition_warp_costs(const MotionGraph& g, const GraphEdge& e, double& warped, double& diagonal) {
+    warped = diagonal = 0.0;
+    const int k = g.window_frames;
+    if (e.kind != GraphEdgeKind::transition || k < 1) return;
+    const WarpPath w = warp_path(g, e);
+    warped = w.total.back();
+    for (int i = 0; i < k; ++i) diagonal += w.cost[static_cast<size_t>(i * k + i)];
+}
+
+std::uint8_t graph_transition_pose(const MotionGraph& g, const GraphEdge& e, int p, const PlanarTransform& world,
+                                   std::span<quat> rotations, std::span<vec3> translations, std::span<const float> warp) {
+    const int k = g.window_frames;
+    int first_a = 0, first_b = 0;
+    transition_windows(g, e, first_a, first_b);
+    const bool warped = warp.size() == static_cast<size_t>(2 * k);
+    const float time_a = warped ? warp[static_cast<size_t>(p)] : static_cast<float>(p);
+    const float time_b = warped ? warp[static_cast<size_t>(k + p)] : static_cast<float>(p);
+    const int fa = first_a + static_cast<int>(time_a + 0.5f), fb = first_b + static_cast<int>(time_b + 0.5f);
+    const PlanarTransform world_b = compose_planar(world, edge_alignment(e));
+    const float alpha = transition_weight(p, k);
+    const size_t joints = static_cast<size_t>(g.joint_count());
     const quat yaw_a = planar_rotation(world), yaw_b = planar_rotation(world_b);
     for (size_t j = 0; j < joints; ++j) {
-        quat qa = g.rotations[base_a + j], qb = g.rotations[base_b + j];
-        vec3 ta = g.translations[base_a + j], tb = g.translations[base_b + j];
+        quat qa, qb;
+        vec3 ta, tb;
+        window_sample(g, first_a, time_a, j, qa, ta);
+        window_sample(g, first_b, time_b, j, qb, tb);
         if (g.skeleton.parents[j] == kNoParent) {
             qa = quat_mul(yaw_a, qa);
             qb = quat_mul(yaw_b, qb);
@@ -246,8 +370,10 @@ Clip synthesize_path(const MotionGraph& g, int start_clip, int start_frame, std:
                 emit();
             }
         } else {
+            std::vector<float> warp(2 * static_cast<size_t>(g.window_frames));
+            transition_time_warp(g, e, warp);
             for (int p = 0; p < e.frames; ++p) {
-                graph_transition_pose(g, e, p, world, r, t);
+                graph_transition_pose(g, e, p, world, r, t, warp);
                 emit();
             }
             world = compose_planar(world, edge_alignment(e));

@@ -102,9 +102,33 @@ void graph_frame_pose(const MotionGraph& graph, int global_frame, const PlanarTr
                       std::span<quat> rotations, std::span<vec3> translations);
 
 // Blend frame p (0 … k−1) of a transition edge, source placed by `world`, target by
-// world ∘ align. Returns the contact bits of the dominant side.
+// world ∘ align. Returns the contact bits of the dominant side. With `warp`
+// (2k floats from transition_time_warp) the two windows are sampled at the
+// registered times warp[p] and warp[k + p] (window frames, interpolated)
+// instead of both at p; empty: unwarped (Kovar's plain blend).
 std::uint8_t graph_transition_pose(const MotionGraph& graph, const GraphEdge& edge, int p, const PlanarTransform& world,
-                                   std::span<quat> rotations, std::span<vec3> translations);
+                                   std::span<quat> rotations, std::span<vec3> translations,
+                                   std::span<const float> warp = {});
+
+// The registration of one transition's two windows (Kovar and Gleicher,
+// "Flexible Automatic Motion Blending with Registration Curves", 2003): the
+// source window (the k frames from the edge's source frame) and the target
+// window (the k frames before the edge's target frame) are aligned by dynamic
+// time warping on a pose distance (Σ over non-root joints of 1 − |q_a·q_b|, in
+// double, joint order), steps (1,1), (1,0), (0,1) within a band of
+// kWarpBandFraction·k frames of the diagonal, ties to the diagonal, then to
+// advancing the source; the path is resampled to k blend frames by arc
+// position and smoothed twice with [1 2 1]/4 (end points fixed: both windows
+// start and end where the plain blend does, so the edge keeps its k frames and
+// its joins). Writes 2k window times to `out` (source times, then target
+// times), each non-decreasing from 0 to k − 1; the identity for a clip edge,
+// k < 3 or `out` not of 2k. Allocates (the k × k table): at graph load and
+// offline, never in the tick.
+void transition_time_warp(const MotionGraph& graph, const GraphEdge& edge, std::span<float> out);
+inline constexpr double kWarpBandFraction = 0.25;
+// The DTW path cost of that alignment and of the diagonal (the plain blend's
+// pairing), for tests and `graph info`: the first is never above the second.
+void transition_warp_costs(const MotionGraph& graph, const GraphEdge& edge, double& warped, double& diagonal);
 
 PlanarTransform edge_alignment(const GraphEdge& edge);
 

@@ -19,9 +19,12 @@ struct GraphSampleJob {
     PlanarTransform world;           // placement of the edge's source
     LocalPoseOutput scratch;         // the later of the two frames (joint_count entries each)
     LocalPoseOutput output;          // out: joint_count entries each, graph units
+    // Per edge, 2·window_frames registered window times (transition_time_warp,
+    // graph_path.hpp; GraphController's table); empty: transitions unwarped.
+    std::span<const float> transition_warps;
 
-    // False without a graph, for an edge not in it, a position off the edge, or
-    // spans not of the graph's joint count.
+    // False without a graph, for an edge not in it, a position off the edge,
+    // spans not of the graph's joint count, or a warp table not of edges × 2k.
     bool validate() const;
     [[nodiscard]] bool run() const;
 };

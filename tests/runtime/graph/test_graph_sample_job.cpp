@@ -31,7 +31,7 @@ TEST_CASE("GraphSampleJob: bad inputs fail validate() and run() writes nothing",
     const MotionGraph graph = test::small_graph();
     REQUIRE(validate_motion_graph(graph).ok());
     test::SentinelPose out(kJoints), scratch(kJoints);
-    const GraphSampleJob valid{&graph, kClipEdge, 1.5f, PlanarTransform{}, scratch.local(), out.local()};
+    const GraphSampleJob valid{&graph, kClipEdge, 1.5f, PlanarTransform{}, scratch.local(), out.local(), {}};
     const auto check_refused = [&](const GraphSampleJob& job) {
         CHECK_FALSE(job.validate());
         CHECK_FALSE(job.run());
@@ -90,7 +90,7 @@ TEST_CASE("GraphSampleJob interpolates between an edge's frames and ends on its 
     std::vector<quat> r(kJoints), scratch_r(kJoints), frame_r(kJoints);
     std::vector<vec3> t(kJoints), scratch_t(kJoints), frame_t(kJoints);
     const PlanarTransform world{0.5, 2.0, -1.0};
-    GraphSampleJob job{&graph, kClipEdge, 2.0f, world, {scratch_r, scratch_t}, {r, t}};
+    GraphSampleJob job{&graph, kClipEdge, 2.0f, world, {scratch_r, scratch_t}, {r, t}, {}};
     // On a frame: that database frame, placed in the world.
     REQUIRE(job.run());
     graph_frame_pose(graph, 2, world, frame_r, frame_t);
@@ -111,7 +111,7 @@ TEST_CASE("GraphSampleJob interpolates between an edge's frames and ends on its 
 TEST_CASE("GraphSampleJob::run never allocates", "[graph][job]") {
     const MotionGraph graph = test::small_graph();
     test::SentinelPose out(kJoints), scratch(kJoints);
-    GraphSampleJob job{&graph, kClipEdge, 0.0f, PlanarTransform{}, scratch.local(), out.local()};
+    GraphSampleJob job{&graph, kClipEdge, 0.0f, PlanarTransform{}, scratch.local(), out.local(), {}};
     int refused = 0;
     const std::uint64_t before = test::allocation_count();
     for (int i = 0; i < 100; ++i) {
