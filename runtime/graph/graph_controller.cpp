@@ -124,10 +124,13 @@ GraphController::GraphController(const MotionGraph& graph, const GraphController
     const int root = root_joint_of(graph);
     facing_offset_ = estimate_graph_facing(graph);
     // Every transition's registration (time warp), once: the tick only reads it.
-    const size_t width = 2 * static_cast<size_t>(graph.window_frames);
-    transition_warps_.assign(graph.edges.size() * width, 0.0f);
-    for (size_t e = 0; e < graph.edges.size(); ++e)
-        transition_time_warp(graph, graph.edges[e], std::span<float>(transition_warps_).subspan(e * width, width));
+    // None for a window too long to warp (the blends stay plain).
+    if (graph.window_frames <= kMaxWarpWindowFrames) {
+        const size_t width = 2 * static_cast<size_t>(graph.window_frames);
+        transition_warps_.assign(graph.edges.size() * width, 0.0f);
+        for (size_t e = 0; e < graph.edges.size(); ++e)
+            transition_time_warp(graph, graph.edges[e], std::span<float>(transition_warps_).subspan(e * width, width));
+    }
     for (size_t f = 0; f < frames; ++f) {
         const vec3 forward = quat_rotate(graph.rotations[f * joints + static_cast<size_t>(root)], vec3(0.0f, 0.0f, 1.0f));
         frame_yaw_[f] = static_cast<float>(det::wrap_angle(det::atan2(forward.x, forward.z) + facing_offset_));

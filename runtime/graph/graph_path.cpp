@@ -271,7 +271,7 @@ void transition_time_warp(const MotionGraph& g, const GraphEdge& e, std::span<fl
     const int k = g.window_frames;
     if (out.size() != static_cast<size_t>(2 * k)) return;
     for (int p = 0; p < k; ++p) out[static_cast<size_t>(p)] = out[static_cast<size_t>(k + p)] = static_cast<float>(p);
-    if (e.kind != GraphEdgeKind::transition || k < 3 || e.frames != k) return;
+    if (e.kind != GraphEdgeKind::transition || k < 3 || k > kMaxWarpWindowFrames || e.frames != k) return;
     const WarpPath w = warp_path(g, e);
     const int last = static_cast<int>(w.path.size()) - 1;
     std::vector<double> a(static_cast<size_t>(k)), b(static_cast<size_t>(k));
@@ -302,7 +302,7 @@ void transition_time_warp(const MotionGraph& g, const GraphEdge& e, std::span<fl
 void transition_warp_costs(const MotionGraph& g, const GraphEdge& e, double& warped, double& diagonal) {
     warped = diagonal = 0.0;
     const int k = g.window_frames;
-    if (e.kind != GraphEdgeKind::transition || k < 1) return;
+    if (e.kind != GraphEdgeKind::transition || k < 1 || k > kMaxWarpWindowFrames || e.frames != k) return;
     const WarpPath w = warp_path(g, e);
     warped = w.total.back();
     for (int i = 0; i < k; ++i) diagonal += w.cost[static_cast<size_t>(i * k + i)];

@@ -122,10 +122,13 @@ std::uint8_t graph_transition_pose(const MotionGraph& graph, const GraphEdge& ed
 // start and end where the plain blend does, so the edge keeps its k frames and
 // its joins). Writes 2k window times to `out` (source times, then target
 // times), each non-decreasing from 0 to k − 1; the identity for a clip edge,
-// k < 3 or `out` not of 2k. Allocates (the k × k table): at graph load and
+// k < 3 or k > kMaxWarpWindowFrames; nothing for `out` not of 2k. Allocates (the k × k table): at graph load and
 // offline, never in the tick.
 void transition_time_warp(const MotionGraph& graph, const GraphEdge& edge, std::span<float> out);
 inline constexpr double kWarpBandFraction = 0.25;
+// Windows longer than this (frames) are not warped (the identity): the DTW table
+// grows as k², and a file may claim any window (the builder's default is 10).
+inline constexpr int kMaxWarpWindowFrames = 64;
 // The DTW path cost of that alignment and of the diagonal (the plain blend's
 // pairing), for tests and `graph info`: the first is never above the second.
 void transition_warp_costs(const MotionGraph& graph, const GraphEdge& edge, double& warped, double& diagonal);

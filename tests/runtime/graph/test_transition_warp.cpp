@@ -21,7 +21,7 @@ using namespace marionette;
 namespace {
 // Clip 0: 60 frames of the swing at rate 1; clip 1: 60 frames at `rate` from
 // `phase`. Nodes at source frame `from` and target frame `to`, one transition.
-MotionGraph swing_graph(int k, double rate, double phase, int from, int to) {
+MotionGraph swing_graph(int k, double rate, double phase, int from, int to, int frames = 60) {
     MotionGraph g;
     g.skeleton.joint_names = {"root", "upper", "lower"};
     g.skeleton.parents = {kNoParent, 0, 1};
@@ -30,9 +30,9 @@ MotionGraph swing_graph(int k, double rate, double phase, int from, int to) {
     g.window_frames = k;
     g.frame_rate = 30.0;
     g.labels = {"walk"};
-    g.clips = {{"a", 1u, 0, 60}, {"b", 1u, 60, 60}};
+    g.clips = {{"a", 1u, 0, frames}, {"b", 1u, frames, frames}};
     for (int c = 0; c < 2; ++c)
-        for (int f = 0; f < 60; ++f) {
+        for (int f = 0; f < frames; ++f) {
             const double t = c == 0 ? f * 0.25 : phase + f * 0.25 * rate;
             g.rotations.push_back(quat_identity());
             g.rotations.push_back(quat_axis_angle(vec3(1, 0, 0), 0.6 * det::sin(t)));
@@ -40,7 +40,7 @@ MotionGraph swing_graph(int k, double rate, double phase, int from, int to) {
             for (int j = 0; j < 3; ++j) g.translations.push_back(j == 0 ? vec3(0.0f, 0.9f, 0.0f) : vec3(0.0f, -0.4f, 0.0f));
             g.contacts.push_back(0);
         }
-    g.nodes = {{0, 0}, {0, from}, {0, 59}, {1, 0}, {1, to}, {1, 59}};
+    g.nodes = {{0, 0}, {0, from}, {0, frames - 1}, {1, 0}, {1, to}, {1, frames - 1}};
     auto clip_edge = [&](int a, int b) {
         GraphEdge e;
         e.from = a, e.to = b, e.kind = GraphEdgeKind::clip;
@@ -159,4 +159,13 @@ TEST_CASE("transition_time_warp: identity for identical windows, clip edges, sho
     std::vector<float> two(4, -1.0f);
     transition_time_warp(short_window, transition_of(short_window), two);
     CHECK((two[0] == 0.0f && two[1] == 1.0f && two[2] == 0.0f && two[3] == 1.0f));
+    // A window past kMaxWarpWindowFrames (a file may claim any): the identity, no k² table.
+    const int long_k = kMaxWarpWindowFrames + 6;
+    const MotionGraph long_window = swing_graph(long_k, 1.4, 1.0, 12, long_k + 10, 3 * long_k);
+    std::vector<float> long_warp(2 * static_cast<size_t>(long_k), -1.0f);
+    transition_time_warp(long_window, transition_of(long_window), long_warp);
+    for (int p = 0; p < long_k; ++p) {
+        CHECK(long_warp[static_cast<size_t>(p)] == static_cast<float>(p));
+        CHECK(long_warp[static_cast<size_t>(long_k + p)] == static_cast<float>(p));
+    }
 }
