@@ -312,13 +312,14 @@ int graph_info_command(const GraphInfoOptions& o) {
     // The transitions' registration (transition_time_warp): DTW path costs
     // summed over every transition, warped against the plain blend's diagonal.
     double warped = 0.0, diagonal = 0.0;
+    const bool warps = transition_warps_affordable(g);
     for (const GraphEdge& e : g.edges) {
         transitions += e.kind == GraphEdgeKind::transition;
         double w = 0.0, d = 0.0;
-        transition_warp_costs(g, e, w, d);
+        if (warps) transition_warp_costs(g, e, w, d);
         warped += w, diagonal += d;
     }
-    const double warp_ratio = diagonal > 0.0 ? warped / diagonal : 1.0;
+    const double warp_ratio = diagonal > 0.0 ? warped / diagonal : 1.0;  // 1: not warped
     const std::vector<std::string> kept = kept_clip_names(g);
     if (o.json) {
         std::string clips, labels, kept_json;
@@ -343,8 +344,12 @@ int graph_info_command(const GraphInfoOptions& o) {
                    g.joint_count(), g.contacts.size(), g.frame_rate, g.window_frames);
         fmt::print("{} nodes, {} edges ({} transitions); before pruning {} nodes, {} edges\n", g.nodes.size(),
                    g.edges.size(), transitions, g.stats.nodes_before, g.stats.edges_before);
-        fmt::print("transitions registered by time warping: pose distance {:.1f} % of the plain blend's\n",
-                   100.0 * warp_ratio);
+        if (warps)
+            fmt::print("transitions registered by time warping: pose distance {:.1f} % of the plain blend's\n",
+                       100.0 * warp_ratio);
+        else
+            fmt::print("transitions not time-warped (window over {} frames, or too many transitions × joints)\n",
+                       kMaxWarpWindowFrames);
         fmt::print("labels: {}\nclips kept: {}\nloaded in {:.2f} ms\n", fmt::join(g.labels, " "), fmt::join(kept, " "),
                    load_ms);
     }

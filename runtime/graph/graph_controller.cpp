@@ -124,8 +124,8 @@ GraphController::GraphController(const MotionGraph& graph, const GraphController
     const int root = root_joint_of(graph);
     facing_offset_ = estimate_graph_facing(graph);
     // Every transition's registration (time warp), once: the tick only reads it.
-    // None for a window too long to warp (the blends stay plain).
-    if (graph.window_frames <= kMaxWarpWindowFrames) {
+    // None where that is unaffordable (the blends stay plain).
+    if (transition_warps_affordable(graph)) {
         const size_t width = 2 * static_cast<size_t>(graph.window_frames);
         transition_warps_.assign(graph.edges.size() * width, 0.0f);
         for (size_t e = 0; e < graph.edges.size(); ++e)

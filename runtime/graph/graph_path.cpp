@@ -299,6 +299,17 @@ void transition_time_warp(const MotionGraph& g, const GraphEdge& e, std::span<fl
     }
 }
 
+bool transition_warps_affordable(const MotionGraph& g) {
+    const int k = g.window_frames;
+    if (k < 3 || k > kMaxWarpWindowFrames) return false;
+    const double band = std::max(1, static_cast<int>(kWarpBandFraction * k));
+    const double cells = static_cast<double>(k) * (2.0 * band + 1.0) * static_cast<double>(g.joint_count());
+    double work = 0.0;
+    for (const GraphEdge& e : g.edges)
+        if (e.kind == GraphEdgeKind::transition) work += cells;
+    return work <= kMaxWarpWork;
+}
+
 void transition_warp_costs(const MotionGraph& g, const GraphEdge& e, double& warped, double& diagonal) {
     warped = diagonal = 0.0;
     const int k = g.window_frames;

@@ -129,6 +129,12 @@ inline constexpr double kWarpBandFraction = 0.25;
 // Windows longer than this (frames) are not warped (the identity): the DTW table
 // grows as k², and a file may claim any window (the builder's default is 10).
 inline constexpr int kMaxWarpWindowFrames = 64;
+// Whether warping every transition of `graph` is affordable: the DTW's cells ×
+// joints summed over the transitions under kMaxWarpWork (~0.5 s; the shipped
+// graphs need ~10⁶). Past it (a crafted or enormous file) the blends stay plain
+// instead of loading for minutes.
+bool transition_warps_affordable(const MotionGraph& graph);
+inline constexpr double kMaxWarpWork = 5e8;
 // The DTW path cost of that alignment and of the diagonal (the plain blend's
 // pairing), for tests and `graph info`: the first is never above the second.
 void transition_warp_costs(const MotionGraph& graph, const GraphEdge& edge, double& warped, double& diagonal);

@@ -168,4 +168,15 @@ TEST_CASE("transition_time_warp: identity for identical windows, clip edges, sho
         CHECK(long_warp[static_cast<size_t>(p)] == static_cast<float>(p));
         CHECK(long_warp[static_cast<size_t>(long_k + p)] == static_cast<float>(p));
     }
+    CHECK_FALSE(transition_warps_affordable(long_window));
+    CHECK(transition_warps_affordable(same));
+    // Too many transitions × joints for the work budget: none warped. (Only
+    // counted, so the copies and extra joints need no frames: 1.1 × the budget.)
+    MotionGraph crowded = same;
+    crowded.edges.insert(crowded.edges.end(), 999, transition_of(same));
+    const double per_joint = 1000.0 * 10.0 * (2.0 * 2.0 + 1.0);  // transitions × k × (2·band + 1)
+    crowded.skeleton.parents.resize(static_cast<size_t>(1.1 * kMaxWarpWork / per_joint), 0);
+    CHECK_FALSE(transition_warps_affordable(crowded));
+    crowded.skeleton.parents.resize(static_cast<size_t>(0.9 * kMaxWarpWork / per_joint), 0);
+    CHECK(transition_warps_affordable(crowded));
 }
