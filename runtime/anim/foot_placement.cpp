@@ -93,7 +93,7 @@ void FootPlacementJob::solve_leg(const FootPlacementLeg& leg, vec3 target, quat 
     if (smooth_feet) {
         const int i = static_cast<int>(&leg - rig->legs.data());
         const float width = soft_reach_width(i), pinned = pinned_weight(i);
-        const float reach = length_of(pose.local_translations[knee]) + length_of(pose.local_translations[ankle]);
+        const float reach = leg_reach(leg);
         vec3 aim = target;
         if (pinned > 0.0f) aim = target + (pinned_reach_target(h, target, reach, width, ik.soft_reach_start) - target) * pinned;
         ik.target = width > 0.0f ? soften_reach(h, aim, reach, width) : aim;
@@ -244,10 +244,14 @@ vec3 FootPlacementJob::pin_target(FootPin& pin, vec3 free, vec3 clip_velocity, b
 // eased out as the foot plants; 0 without smooth_feet.
 float FootPlacementJob::soft_reach_width(int i) const {
     if (!smooth_feet) return 0.0f;
-    const FootPlacementLeg& leg = rig->legs[static_cast<size_t>(i)];
-    const float reach = length_of(pose.local_translations[static_cast<size_t>(leg.knee)]) +
-                        length_of(pose.local_translations[static_cast<size_t>(leg.ankle)]);
-    return kSoftReachFraction * (1.0f - smoothstep(state->feet[static_cast<size_t>(i)].plant)) * reach;
+    return kSoftReachFraction * (1.0f - smoothstep(state->feet[static_cast<size_t>(i)].plant)) *
+           leg_reach(rig->legs[static_cast<size_t>(i)]);
+}
+
+// The leg's length: thigh plus shin (the pose's knee and ankle offsets).
+float FootPlacementJob::leg_reach(const FootPlacementLeg& leg) const {
+    return length_of(pose.local_translations[static_cast<size_t>(leg.knee)]) +
+           length_of(pose.local_translations[static_cast<size_t>(leg.ankle)]);
 }
 
 // 1 while leg i is pinned, eased out (smoothstep) over release_s after it lets go.
@@ -315,9 +319,7 @@ void FootPlacementJob::lower_for_reach(const vec3 (&targets)[2]) const {
     for (int i = 0; i < 2; ++i) {
         if (s.feet[static_cast<size_t>(i)].contact != 1) continue;
         const FootPlacementLeg& leg = rig->legs[static_cast<size_t>(i)];
-        const float reach = length_of(pose.local_translations[static_cast<size_t>(leg.knee)]) +
-                            length_of(pose.local_translations[static_cast<size_t>(leg.ankle)]);
-        const float l = (reach - soft_reach_width(i)) * kPinnedReachFraction;
+        const float l = (leg_reach(leg) - soft_reach_width(i)) * kPinnedReachFraction;
         // Eased in as the foot plants: a pin starts wherever the foot touched
         // down, so its need can start at any size (taken at once, it dropped
         // the body in a tick and turned the shins at up to 2,034 °/s).

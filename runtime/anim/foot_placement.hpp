@@ -216,6 +216,7 @@ private:
     bool lift_feet_above_ground(vec3 forward) const;
     void lower_for_reach(const vec3 (&targets)[2]) const;
     float soft_reach_width(int leg) const;
+    float leg_reach(const FootPlacementLeg& leg) const;
     float pinned_weight(int leg) const;
     vec3 smooth_lift(FootPin& pin, const FootPlacementLeg& leg) const;
     vec3 pin_target(FootPin& pin, vec3 free, vec3 clip_velocity, bool let_go) const;

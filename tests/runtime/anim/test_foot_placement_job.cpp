@@ -17,6 +17,17 @@
 using namespace marionette;
 
 namespace {
+// The generated cases' fixed-seed generator: uniform floats in [0, 1).
+struct Lcg {
+    std::uint32_t seed;
+    float next() {
+        seed = seed * 1664525u + 1013904223u;
+        return static_cast<float>(seed >> 8) / 16777216.0f;
+    }
+};
+float norm_of(vec3 v) { return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z); }
+float distance_of(vec3 a, vec3 b) { return norm_of(b - a); }
+
 // Pelvis, then each leg hip → knee → ankle: thigh 0.45 m, shin 0.43 m.
 constexpr int kLeftAnkle = 3, kRightAnkle = 6;
 constexpr std::uint8_t kBothFeetInContact = 3;  // contact bits: 1 left, 2 right
@@ -153,9 +164,8 @@ TEST_CASE("FootPlacementJob raises the body to the ground and keeps the legs' le
     CHECK(clip.local_translations[0].y == Approx(1.1f));
     CHECK(clip.model_positions[kLeftAnkle].y == Approx(clip_left_ankle.y + 0.2f).margin(1e-4));
     for (const FootPin& foot : state.feet) CHECK(foot.contact == 1);
-    const auto length = [](vec3 v) { return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z); };
-    CHECK(length(clip.model_positions[2] - clip.model_positions[1]) == Approx(0.45f).margin(1e-5));
-    CHECK(length(clip.model_positions[3] - clip.model_positions[2]) == Approx(0.43f).margin(1e-5));
+    CHECK(norm_of(clip.model_positions[2] - clip.model_positions[1]) == Approx(0.45f).margin(1e-5));
+    CHECK(norm_of(clip.model_positions[3] - clip.model_positions[2]) == Approx(0.43f).margin(1e-5));
 }
 
 TEST_CASE("FootPlacementJob::run never allocates", "[foot_placement][job]") {
@@ -195,8 +205,8 @@ float foot_clearance(const FootPlacementRig& rig, const ClipPose& pose, const Te
 TEST_CASE("FootPlacementJob: keep_above_ground lifts a foot whose tip is under the ground", "[foot_placement][job]") {
     FootPlacementRig rig = make_foot_placement_rig(kLegParents, kLeftAnkle, kRightAnkle);
     const std::vector<int> site_parents = {kLeftAnkle, kRightAnkle};
-    std::uint32_t seed = 777u;
-    auto next = [&] { seed = seed * 1664525u + 1013904223u; return static_cast<float>(seed >> 8) / 16777216.0f; };
+    Lcg rng{777u};
+    auto next = [&] { return rng.next(); };
     // Generated cases (fixed seed): tips 0–15 cm below and 0–25 cm ahead of the
     // ankle (in metres ×2: the scale is applied), ground from −5 to +5 cm.
     for (int c = 0; c < 200; ++c) {
@@ -253,8 +263,8 @@ TEST_CASE("FootPlacementJob: keep_above_ground lifts a foot whose tip is under t
 // clip's bend, and the same cases must show the swing there.
 TEST_CASE("FootPlacementJob: smooth_feet's knee bends toward the thigh however straight the clip's leg", "[foot_placement][job]") {
     const FootPlacementRig rig = make_foot_placement_rig(kLegParents, kLeftAnkle, kRightAnkle);
-    std::uint32_t seed = 1414u;
-    auto next = [&] { seed = seed * 1664525u + 1013904223u; return static_cast<float>(seed >> 8) / 16777216.0f; };
+    Lcg rng{1414u};
+    auto next = [&] { return rng.next(); };
     float widest_swing_without = 0.0f;
     for (int c = 0; c < 300; ++c) {
         const float pitch = -0.5f + 0.8f * next(), bend = 0.002f + 0.018f * next(), phi = 6.2831853f * next();
@@ -380,11 +390,8 @@ double tilt_turn_bound(const std::vector<vec3>& goals) {
 }  // namespace
 
 TEST_CASE("step_tilt_normal: generated ground normals, unit, rate-bounded, converging, reproducible", "[foot_placement][tilt]") {
-    std::uint32_t seed = 2026u;
-    const std::function<float()> next = [&] {
-        seed = seed * 1664525u + 1013904223u;
-        return static_cast<float>(seed >> 8) / 16777216.0f;
-    };
+    Lcg rng{2026u};
+    const std::function<float()> next = [&] { return rng.next(); };
     double worst_ratio = 0.0, worst_single_step_deg_s = 0.0;
     for (int n = 0; n < 400; ++n) {
         const int kind = n % 4;
@@ -456,8 +463,8 @@ TEST_CASE("FootPlacementJob: smooth_feet carries free feet over generated stairs
     const std::vector<int> site_parents = {kLeftAnkle, kRightAnkle};
     const std::vector<vec3> site_offsets = {vec3(0.0f, -0.05f, 0.12f), vec3(0.0f, -0.05f, 0.12f)};
     add_foot_tips(rig, kLegParents, site_parents, site_offsets, 1.0f);
-    std::uint32_t seed = 2026u;
-    auto next = [&] { seed = seed * 1664525u + 1013904223u; return static_cast<float>(seed >> 8) / 16777216.0f; };
+    Lcg rng{2026u};
+    auto next = [&] { return rng.next(); };
     const float rates[] = {60.0f, 120.0f, 144.0f, 240.0f, 500.0f, 1000.0f};
     float fastest_extra = 0.0f, deepest = 0.0f;
     int held_cases = 0;
@@ -528,12 +535,8 @@ TEST_CASE("FootPlacementJob: smooth_feet carries free feet over generated stairs
 // ~1 just past reach − width (no kink where the easing starts).
 TEST_CASE("soften_reach: generated targets, unchanged inside, eased short of reach outside, monotonic, C1",
           "[foot_placement][soft_reach]") {
-    std::uint32_t seed = 31337u;
-    auto next = [&] { seed = seed * 1664525u + 1013904223u; return static_cast<float>(seed >> 8) / 16777216.0f; };
-    auto distance = [](vec3 a, vec3 b) {
-        const vec3 d = b - a;
-        return std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-    };
+    Lcg rng{31337u};
+    auto next = [&] { return rng.next(); };
     int eased = 0;
     for (int c = 0; c < 2000; ++c) {
         const vec3 root(20.0f * next() - 10.0f, 20.0f * next() - 10.0f, 20.0f * next() - 10.0f);
@@ -554,22 +557,22 @@ TEST_CASE("soften_reach: generated targets, unchanged inside, eased short of rea
             continue;
         }
         ++eased;
-        const float got = distance(root, out);
+        const float got = distance_of(root, out);
         CHECK(got <= reach + 2e-5f);  // short of reach; far out it rounds to it (hips 10 m out: ulps of 1e-6 m)
         CHECK(got >= start - 1e-4f * reach);
         const vec3 along = (out - root) / got;  // the same ray
         CHECK(along.x * dir.x + along.y * dir.y + along.z * dir.z > 1.0f - 1e-5f);
         // Increasing: a target 1 mm farther is eased at least as far.
-        CHECK(distance(root, soften_reach(root, root + dir * (d + 1e-3f), reach, width)) >= got - 1e-5f);
+        CHECK(distance_of(root, soften_reach(root, root + dir * (d + 1e-3f), reach, width)) >= got - 1e-5f);
     }
     CHECK(eased > 500);
     // No kink at start: the slope just past it is ~1, and far out it flattens.
     const vec3 root(0.0f), dir(0.0f, -1.0f, 0.0f);
     for (const float width : {0.01f, 0.03f, 0.1f}) {
         const float reach = 0.9f, start = reach - width, step = 1e-3f * width;
-        const float just_past = distance(root, soften_reach(root, dir * (start + step), reach, width));
+        const float just_past = distance_of(root, soften_reach(root, dir * (start + step), reach, width));
         CHECK((just_past - start) / step == Approx(1.0).margin(0.01));
-        const float far = distance(root, soften_reach(root, dir * (reach + 10.0f * width), reach, width));
+        const float far = distance_of(root, soften_reach(root, dir * (reach + 10.0f * width), reach, width));
         CHECK(far > reach - 0.02f * width);
         CHECK(far < reach);
     }
@@ -584,8 +587,8 @@ TEST_CASE("soften_reach: generated targets, unchanged inside, eased short of rea
 // on the same ray, increasing with the target's distance (no jump at the edge).
 TEST_CASE("pinned_reach_target: generated pins, the softened IK lands on them exactly, continuous beyond",
           "[foot_placement][soft_reach]") {
-    std::uint32_t seed = 4242u;
-    auto next = [&] { seed = seed * 1664525u + 1013904223u; return static_cast<float>(seed >> 8) / 16777216.0f; };
+    Lcg rng{4242u};
+    auto next = [&] { return rng.next(); };
     auto ankle_for = [](vec3 root, vec3 target, float reach, float width, float soft_start) {
         TwoBoneIkJob ik;
         ik.root = root;
@@ -597,12 +600,11 @@ TEST_CASE("pinned_reach_target: generated pins, the softened IK lands on them ex
         REQUIRE(ik.run());
         return r.end;
     };
-    auto length = [](vec3 v) { return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z); };
     int exact = 0, beyond = 0;
     for (int c = 0; c < 3000; ++c) {
         const vec3 root(20.0f * next() - 10.0f, 20.0f * next() - 10.0f, 20.0f * next() - 10.0f);
         vec3 dir(2.0f * next() - 1.0f, 2.0f * next() - 1.0f, 2.0f * next() - 1.0f);
-        const float n = length(dir);
+        const float n = norm_of(dir);
         if (n < 1e-3f) continue;
         dir = dir / n;
         const float reach = 0.3f + 1.7f * next();
@@ -613,10 +615,10 @@ TEST_CASE("pinned_reach_target: generated pins, the softened IK lands on them ex
         INFO("case " << c << ": reach " << reach << " width " << width << " soft start " << soft_start << " distance " << d);
         const vec3 ankle = ankle_for(root, target, reach, width, soft_start);
         const float top = width > 0.0f ? reach * (soft_start + 0.5f * (1.0f - soft_start)) : reach;
-        const float got = length(ankle - root);
+        const float got = norm_of(ankle - root);
         if (d <= kPinExactReachFraction * top) {
             ++exact;
-            CHECK(length(ankle - target) <= 2e-5f);
+            CHECK(norm_of(ankle - target) <= 2e-5f);
         } else {
             ++beyond;
             const vec3 along = (ankle - root) / got;
@@ -624,7 +626,7 @@ TEST_CASE("pinned_reach_target: generated pins, the softened IK lands on them ex
             CHECK(got <= reach + 2e-5f);
         }
         // Increasing, and continuous: 0.1 mm farther moves the ankle out by 0 to 0.1 mm.
-        const float farther = length(ankle_for(root, root + dir * (d + 1e-4f), reach, width, soft_start) - root);
+        const float farther = norm_of(ankle_for(root, root + dir * (d + 1e-4f), reach, width, soft_start) - root);
         CHECK(farther >= got - 1e-5f);
         CHECK(farther <= got + 1e-4f + 2e-5f);
     }
@@ -640,12 +642,8 @@ TEST_CASE("pinned_reach_target: generated pins, the softened IK lands on them ex
 // by 1 mm less does not reach it (the least drop, not merely one); where none
 // does, the answer brings the target nearest (1 mm more or less is no nearer).
 TEST_CASE("reach_drop_needed: generated hips and targets, the least drop that reaches, capped", "[foot_placement][reach_drop]") {
-    std::uint32_t seed = 4242u;
-    auto next = [&] { seed = seed * 1664525u + 1013904223u; return static_cast<float>(seed >> 8) / 16777216.0f; };
-    auto distance = [](vec3 a, vec3 b) {
-        const vec3 d = b - a;
-        return std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-    };
+    Lcg rng{4242u};
+    auto next = [&] { return rng.next(); };
     int reached = 0, nearest = 0;
     for (int c = 0; c < 3000; ++c) {
         const vec3 hip(20.0f * next() - 10.0f, 20.0f * next() - 10.0f, 20.0f * next() - 10.0f);
@@ -657,24 +655,24 @@ TEST_CASE("reach_drop_needed: generated hips and targets, the least drop that re
         // Every other case just past reach and below the hip, as a pinned ankle is.
         if (c % 2) dir.y = -std::fabs(dir.y);
         const vec3 target = hip + dir * ((c % 2 ? 0.9f + 0.3f * next() : 2.0f * next()) * reach);
-        INFO("case " << c << ": reach " << reach << " cap " << cap << " distance " << distance(hip, target) << " dir.y " << dir.y);
+        INFO("case " << c << ": reach " << reach << " cap " << cap << " distance " << distance_of(hip, target) << " dir.y " << dir.y);
         const float drop = reach_drop_needed(hip, target, reach, cap);
         REQUIRE(drop >= 0.0f);
         REQUIRE(drop <= cap);
-        if (distance(hip, target) <= reach * (1.0f - 1e-5f)) {
+        if (distance_of(hip, target) <= reach * (1.0f - 1e-5f)) {
             CHECK(drop == 0.0f);
             continue;
         }
         const vec3 lowered = hip - vec3(0.0f, drop, 0.0f);
-        const float at = distance(lowered, target);
+        const float at = distance_of(lowered, target);
         if (at <= reach * (1.0f + 1e-4f)) {
             ++reached;
             CHECK(at >= reach * (1.0f - 1e-4f));
-            if (drop > 1e-3f) CHECK(distance(lowered + vec3(0.0f, 1e-3f, 0.0f), target) > reach);
+            if (drop > 1e-3f) CHECK(distance_of(lowered + vec3(0.0f, 1e-3f, 0.0f), target) > reach);
         } else {
             ++nearest;
-            if (drop + 1e-3f <= cap) CHECK(distance(lowered - vec3(0.0f, 1e-3f, 0.0f), target) >= at * (1.0f - 1e-6f));
-            if (drop >= 1e-3f) CHECK(distance(lowered + vec3(0.0f, 1e-3f, 0.0f), target) >= at * (1.0f - 1e-6f));
+            if (drop + 1e-3f <= cap) CHECK(distance_of(lowered - vec3(0.0f, 1e-3f, 0.0f), target) >= at * (1.0f - 1e-6f));
+            if (drop >= 1e-3f) CHECK(distance_of(lowered + vec3(0.0f, 1e-3f, 0.0f), target) >= at * (1.0f - 1e-6f));
         }
     }
     INFO(reached << " reached, " << nearest << " as near as it gets");

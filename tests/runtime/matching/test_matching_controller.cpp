@@ -24,6 +24,29 @@ TrajectoryGoal goal_of(double speed, double heading) {
     det::sin_cos(heading, s, c);
     return {static_cast<float>(speed * s), static_cast<float>(speed * c), static_cast<float>(heading)};
 }
+// Joint speeds of the fixture's seven-joint pose, tick to tick: each joint's
+// (not the root's) angular speed, and the largest change of any joint's speed
+// since the last tick (rad/s per tick), from the third pose on (0 before: the
+// first speed needs two poses, the first change three).
+struct SpeedSteps {
+    std::array<quat, 7> previous{};
+    std::array<double, 7> previous_speed{};
+    int poses = 0;
+    double fastest = 0.0;  // this tick's fastest joint, rad/s
+    double step(const std::array<quat, 7>& r, float dt) {
+        double largest = 0.0;
+        fastest = 0.0;
+        for (size_t j = 1; j < 7 && poses >= 1; ++j) {
+            const double speed = quat_angle_between(previous[j], r[j]) / dt;
+            fastest = std::max(fastest, speed);
+            if (poses >= 2) largest = std::max(largest, std::fabs(speed - previous_speed[j]));
+            previous_speed[j] = speed;
+        }
+        previous = r;
+        ++poses;
+        return largest;
+    }
+};
 }  // namespace
 
 TEST_CASE("matching controller: step refuses bad spans and states, touching nothing", "[matching]") {
@@ -123,28 +146,19 @@ TEST_CASE("matching controller: a jump adds no joint-speed spike beyond the clip
     std::int64_t jumps = 0;
     for (int trial = 0; trial < 8; ++trial) {
         MatchingState s = mc.initial_state(vec3(0.0f), 0.0f);
-        std::array<quat, 7> r{}, previous{};
+        std::array<quat, 7> r{};
         std::array<vec3, 7> t{};
-        std::array<double, 7> previous_speed{};
+        SpeedSteps speeds;
         MatchingInput in;
         in.dt = dt;
         for (int tick = 0; tick < 240 * 6; ++tick) {
             if (tick % 120 == 0) in.goal = goal_of(0.2 + 2.6 * test::fixture_unit(rng), (test::fixture_unit(rng) * 2.0 - 1.0) * 3.0);
             const std::int64_t before = s.jumps;
             REQUIRE(mc.step(s, in, {r, t}));
-            if (tick >= 2) {
-                for (size_t j = 1; j < n; ++j) {
-                    const double speed = quat_angle_between(previous[j], r[j]) / dt;
-                    worst_speed = std::max(worst_speed, speed);
-                    const double step = std::fabs(speed - previous_speed[j]);  // rad/s per tick
-                    (s.jumps != before ? worst_jump_step : worst_steady_step) =
-                        std::max(s.jumps != before ? worst_jump_step : worst_steady_step, step);
-                    previous_speed[j] = speed;
-                }
-            } else {
-                for (size_t j = 1; j < n; ++j) previous_speed[j] = tick == 1 ? quat_angle_between(previous[j], r[j]) / dt : 0.0;
-            }
-            previous = r;
+            const double step = speeds.step(r, dt);
+            worst_speed = std::max(worst_speed, speeds.fastest);
+            double& worst = s.jumps != before ? worst_jump_step : worst_steady_step;
+            worst = std::max(worst, step);
         }
         jumps += s.jumps;
     }
@@ -201,11 +215,10 @@ TEST_CASE("matching controller: an action clip plays on request, entered and lef
 
     MatchingController mc(source, db, {});
     const float dt = 1.0f / 240.0f;
-    const size_t n = 7;
     MatchingState s = mc.initial_state(vec3(0.0f), 0.0f);
-    std::array<quat, 7> r{}, previous{};
+    std::array<quat, 7> r{};
     std::array<vec3, 7> t{};
-    std::array<double, 7> previous_speed{};
+    SpeedSteps speeds;
     MatchingInput in;
     in.dt = dt;
     in.goal = goal_of(1.2, 0.4);
@@ -229,16 +242,8 @@ TEST_CASE("matching controller: an action clip plays on request, entered and lef
             ++acting_ticks;
         }
         if (left >= 0 && tick == left + 240) after_start = mc.root_position(s);
-        if (tick >= 2) {
-            const bool edge = acting != was_acting;
-            for (size_t j = 1; j < n; ++j) {
-                const double speed = quat_angle_between(previous[j], r[j]) / dt;
-                double& worst = edge ? worst_edge_step : worst_steady_step;
-                worst = std::max(worst, std::fabs(speed - previous_speed[j]));
-                previous_speed[j] = speed;
-            }
-        }
-        previous = r;
+        double& worst = acting != was_acting ? worst_edge_step : worst_steady_step;
+        worst = std::max(worst, speeds.step(r, dt));
     }
     CHECK(test::allocation_count() == allocations);
     CHECK(first_bad_tick == -1);
