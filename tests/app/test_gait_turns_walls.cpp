@@ -23,22 +23,13 @@
 #include "app/eval/gait_eval.hpp"
 #include "runtime/ground/obstacles.hpp"
 #include "runtime/sim/simulation.hpp"
+#include "tests/seeded_random.hpp"
 
 using namespace marionette;
 
 namespace {
 
-// A small fixed-seed generator (splitmix64), the same on every platform.
-struct Rng {
-    std::uint64_t state;
-    std::uint64_t next() {
-        std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    }
-    double uniform(double lo, double hi) { return lo + (hi - lo) * static_cast<double>(next() >> 11) * 0x1.0p-53; }
-};
+using Rng = test::SeededRandom;
 
 GaitMetrics run(const std::string& text, const Terrain& terrain = {}) {
     SimConfig c;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "runtime/formats/bvh.hpp"
+#include "tests/seeded_random.hpp"
 #include "tests/test_support.hpp"
 
 using namespace marionette;
@@ -154,18 +155,7 @@ bool parses_or_import_error(const std::string& text) {
     }
 }
 
-// Deterministic on every platform, unlike the std distributions.
-struct SplitMix {
-    std::uint64_t state;
-    std::uint64_t next() {
-        std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    }
-    double unit() { return static_cast<double>(next() >> 11) / 9007199254740992.0; }  // [0, 1)
-    size_t below(size_t n) { return static_cast<size_t>(next() % n); }
-};
+using SplitMix = test::SeededRandom;
 
 void require_same_skeleton(const Skeleton& a, const Skeleton& b) {
     REQUIRE(a.joint_names == b.joint_names);
