@@ -1206,6 +1206,24 @@ bool positive_length(float metres) { return metres > 0.0f && std::isfinite(metre
 // finite bone lengths, a finite state): validated once per pose, not again per
 // limb (TwoBoneIkJob::run would repeat the check four times a tick).
 TwoBoneIkResult solve_limb(const TwoBoneIkJob& ik) { return solve_two_bone_ik(ik); }
+
+// The knee's pole: the hip→ankle direction turned 90° forward about the hips'
+// left-right axis, so the knee points forward for a leg hanging down, up for a
+// foot raised ahead to hip height, down for a foot kicked back. A fixed forward
+// pole gives the same knee for a foot below the hip (the IK keeps only the
+// pole's part perpendicular to the leg) but degenerates as the ankle nears hip
+// height ahead of it and flips the knee through 180° when the ankle passes
+// above: a swing foot over a riser or an uphill curb spun the shin at
+// thousands of degrees per second. The small forward part keeps the pole
+// defined for a leg pointing straight sideways and never changes a leg in the
+// sagittal plane (its projection is a positive multiple of the turned leg).
+vec3 knee_pole(const HeadingFrame& h, vec3 hip, vec3 ankle) {
+    const vec3 leg = ankle - hip;
+    const float ahead = dot3(leg, h.forward);
+    const float up = leg.y;
+    const float bias = 0.5f * length3(leg) + 1e-3f;
+    return h.forward * (bias - up) + vec3(0.0f, ahead, 0.0f);
+}
 }  // namespace
 
 bool GaitPoseJob::validate() const {
@@ -1250,7 +1268,7 @@ bool GaitPoseJob::run() const {
         TwoBoneIkJob ik;
         ik.root = g.pelvis + h.left * (side_sign(i) * r.hip_half_width);
         ik.target = f.ankle;
-        ik.pole = h.forward;
+        ik.pole = knee_pole(h, ik.root, f.ankle);
         ik.upper_length = r.thigh;
         ik.lower_length = r.shin;
         const TwoBoneIkResult s = solve_limb(ik);

@@ -1,14 +1,17 @@
 // GaitPoseJob (runtime/gait/gait.hpp): the pose of a gait state, as a job.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include "runtime/gait/gait.hpp"
 #include "runtime/gait/puppet.hpp"
+#include "runtime/math/det_math.hpp"
 #include "runtime/sim/simulation.hpp"
 #include "tests/alloc_counter.hpp"
 #include "tests/job_sentinel.hpp"
+#include "tests/seeded_random.hpp"
 
 using namespace marionette;
 
@@ -133,4 +136,55 @@ TEST_CASE("GaitPoseJob::run never allocates", "[gait][job]") {
         if (!job.run()) ++refused;
     CHECK(test::allocation_count() == before);
     CHECK(refused == 0);
+}
+
+// The knee follows the ankle smoothly wherever a swing can take it: below the
+// hip, beside it, ahead of it and behind it at hip height (a foot swung onto a
+// high step or lifted off one). A fixed forward pole flipped the knee through
+// 180° in one tick as the ankle passed hip height ahead of the hip, and turned
+// it fast about a leg pointing sideways (sweep cases 7-0901, 2-0186).
+// Generated walks of the right ankle in 2 mm steps, each step's thigh and shin
+// turn held to a multiple of the turn the hip→ankle line itself makes.
+TEST_CASE("GaitPoseJob: the knee turns smoothly with the ankle anywhere a swing takes it", "[gait][job]") {
+    StandingPuppet puppet;
+    test::SentinelPose out(kJoints);
+    const GaitPoseJob job = puppet.job(out.spans());
+    REQUIRE(job.run());
+    const vec3 hip = out.model_positions[kThighR];
+    const float reach = puppet.rig.thigh + puppet.rig.shin;
+    test::SeededRandom rng{2001};
+    const auto random_direction = [&] {
+        // Anywhere below the hip up to 12° above its height, any heading.
+        const double yaw = rng.uniform(-det::kPi, det::kPi);
+        const double elevation = rng.uniform(-0.5 * det::kPi, 0.21);
+        return vec3(static_cast<float>(std::cos(elevation) * std::sin(yaw)), static_cast<float>(std::sin(elevation)),
+                    static_cast<float>(std::cos(elevation) * std::cos(yaw)));
+    };
+    double worst_ratio = 0.0;
+    int steps = 0;
+    for (int walk = 0; walk < 300; ++walk) {
+        const float distance = static_cast<float>(rng.uniform(0.35, 0.95)) * reach;
+        vec3 direction = random_direction();
+        const vec3 heading_to = random_direction();
+        quat thigh{}, shin{};
+        for (int step = 0; step <= 120; ++step) {
+            // Turn the direction toward another one, 2 mm of ankle travel a step.
+            if (step > 0) direction = normalize(direction + (heading_to - direction * dot(heading_to, direction)) * (0.002f / distance));
+            if (direction.y > 0.21f) break;
+            puppet.gait.feet[1].ankle = hip + direction * distance;
+            REQUIRE(puppet.job(out.spans()).run());
+            if (step > 0) {
+                const double line_turn = 0.002 / distance;
+                const double turn = std::max(quat_angle_between(thigh, out.model_rotations[kThighR]),
+                                             quat_angle_between(shin, out.model_rotations[kShinR]));
+                worst_ratio = std::max(worst_ratio, turn / line_turn);
+                ++steps;
+            }
+            thigh = out.model_rotations[kThighR];
+            shin = out.model_rotations[kShinR];
+        }
+    }
+    INFO("steps " << steps << ", worst knee turn per hip-ankle line turn " << worst_ratio);
+    CHECK(steps > 20000);
+    CHECK(worst_ratio < 4.0);
 }
