@@ -442,6 +442,9 @@ void Simulation::begin_source_change(std::int32_t source) {
         matching_->place(s.matching, s.root_position, s.heading);
         s.matching_feet = FootPlacementState{};
         s.matching_active = 1;
+        // A button held across the switch is not a press: presses count from
+        // the buttons held now, not from when matching last ran.
+        s.matching.held_buttons = s.input.buttons;
     } else if (current == kSourceGait || current == kSourceMatching) {
         // Re-place the graph's motion so its root is where the puppet is, facing its way.
         const size_t n = static_cast<size_t>(graph_->joint_count());
@@ -458,6 +461,7 @@ void Simulation::begin_source_change(std::int32_t source) {
         s.graph.world_angle = world.angle, s.graph.world_dx = world.dx, s.graph.world_dz = world.dz;
         s.graph.search_depth = -1;  // the look-ahead was placed in the old frame: start it again
         s.graph.best_edge = -1;
+        s.graph.last_buttons = s.input.buttons;  // held across the switch: not a press
     }
     if (source == kSourceGraphFeet) s.feet = FootPlacementState{};
     s.fade = MotionFade{};

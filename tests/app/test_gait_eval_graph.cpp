@@ -226,3 +226,48 @@ TEST_CASE("gait-eval: matching plays each action button's graph clip through and
         CHECK(m.pop_ratio <= 4.0);
     }
 }
+
+// A button held while the puppet switches into matching or graph mode (a live
+// retune) is not a press there: it plays nothing until it is released and
+// pressed again. Before, matching and the graph compared with the buttons of
+// the last tick they had run (none here), so a held button started its action.
+TEST_CASE("gait-eval: a button held across a switch into matching or the graph is not a press", "[gait_eval][matching][action]") {
+    set_simulation_float_mode();
+    const AppConfig shipped = default_config();
+    SimConfig config = shipped.sim;
+    config.terrain_name = "flat";
+    config.terrain = load_terrain("flat");
+    const auto graph = std::make_shared<const MotionGraph>(build_default_motion_graph(config, shipped.graph_build));
+    for (const MotionSourceSetting source : {MotionSourceSetting::matching, MotionSourceSetting::graph}) {
+        INFO((source == MotionSourceSetting::matching ? "into matching" : "into the graph"));
+        SimConfig start = config;
+        start.motion_source = MotionSourceSetting::gait;
+        Simulation sim(start);
+        attach_motion_graph(sim, graph, "default");
+        TickInput in;
+        in.left_y = static_cast<std::int16_t>(-0.6 * 32767);
+        for (int tick = 0; tick < 240; ++tick) sim.step(in);
+        in.buttons = button_bit(Button::south);  // jump, held down in gait mode
+        for (int tick = 0; tick < 60; ++tick) sim.step(in);
+        SimConfig next = start;
+        next.motion_source = source;
+        REQUIRE(sim.retune(next).ok());
+        const auto acting = [&] {
+            return source == MotionSourceSetting::matching ? sim.state().matching.action >= 0 : sim.state().graph.action_label >= 0;
+        };
+        int acted = 0;
+        for (int tick = 0; tick < 240; ++tick) {
+            sim.step(in);
+            acted += acting() ? 1 : 0;
+        }
+        CHECK(acted == 0);
+        in.buttons = 0;
+        for (int tick = 0; tick < 10; ++tick) sim.step(in);
+        in.buttons = button_bit(Button::south);
+        for (int tick = 0; tick < 120; ++tick) {
+            sim.step(in);
+            acted += acting() ? 1 : 0;
+        }
+        CHECK(acted > 0);  // a real press still plays it
+    }
+}
