@@ -76,6 +76,14 @@ struct FillOptions {
     // the capture's frame-to-frame jitter of a pelvis or clavicle does not reach the
     // filled limb (docs/fill.md). 0: fill in the parent's own frame.
     double parent_smooth_s = 0.05;
+    // Gaps longer than this are filled whole first, then again in equal pieces
+    // no longer than it, one after the other, each between the frame before it
+    // (known, or the previous piece's fill) and the whole fill after it, so
+    // database motion shorter than the gap can match (docs/fill.md). 0: whole only.
+    double piece_s = 2.0;
+    // Database frames between the coarse search's starts (DTW then refines the
+    // best); the pieces' searches use 2 (docs/fill.md, speed).
+    int coarse_stride = 1;
     // Evaluation only (`fill-eval --oracle-match`): the search also sees the hidden
     // joints' values inside the gap — which the clip must still hold (the truth) —
     // so the match is the best in hindsight. Separates a wrong match from what

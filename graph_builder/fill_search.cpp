@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <thread>
 
 #include "runtime/math/planar_alignment.hpp"
 
@@ -115,23 +116,34 @@ Candidate score(const Query& q, const std::vector<int>& sample, const FillDataba
     return Candidate{sum / static_cast<double>(sample.size()), c, start, scale};
 }
 
-std::vector<Candidate> coarse_search(const Query& q, const FillDatabase& db, double velocity_weight) {
+std::vector<Candidate> coarse_search(const Query& q, const FillDatabase& db, double velocity_weight, int stride_frames) {
     std::vector<int> sample;
     const int stride = std::max(1, (q.frames + kCoarseFrames - 1) / kCoarseFrames);
     for (int i = 0; i < q.frames; i += stride) sample.push_back(i);
     if (sample.back() != q.frames - 1) sample.push_back(q.frames - 1);
-    std::vector<vec3> b;
     const std::vector<float> w = point_weights(q, velocity_weight);
-    std::vector<Candidate> all;
-    for (int c = 0; c < static_cast<int>(db.clips.size()); ++c) {
-        const int last = db.clips[static_cast<size_t>(c)].frame_count - 1;
-        for (double scale : kScales) {
-            const double span = (q.frames - 1) * scale;
-            for (int s = 0; s + span <= last + 1e-9; ++s) {
-                all.push_back(score(q, sample, db, c, s, scale, b, w));
+    // Clips are scored on every core (worker k takes clips k, k + workers, …);
+    // each candidate's score does not depend on which worker made it, and the
+    // sort below orders them totally, so the result is the same on any machine.
+    const int clips = static_cast<int>(db.clips.size());
+    const int workers = std::max(1, std::min(clips, static_cast<int>(std::min(8u, std::thread::hardware_concurrency()))));
+    std::vector<std::vector<Candidate>> found(static_cast<size_t>(workers));
+    const auto work = [&](int k) {
+        std::vector<vec3> b;
+        for (int c = k; c < clips; c += workers) {
+            const int last = db.clips[static_cast<size_t>(c)].frame_count - 1;
+            for (double scale : kScales) {
+                const double span = (q.frames - 1) * scale;
+                for (int s = 0; s + span <= last + 1e-9; s += stride_frames) found[static_cast<size_t>(k)].push_back(score(q, sample, db, c, s, scale, b, w));
             }
         }
-    }
+    };
+    std::vector<std::thread> threads;  // the calling thread is worker 0
+    for (int k = 1; k < workers; ++k) threads.emplace_back(work, k);
+    work(0);
+    for (std::thread& t : threads) t.join();
+    std::vector<Candidate> all;
+    for (const std::vector<Candidate>& f : found) all.insert(all.end(), f.begin(), f.end());
     std::sort(all.begin(), all.end(), [](const Candidate& x, const Candidate& y) {
         if (x.distance != y.distance) return x.distance < y.distance;
         if (x.clip != y.clip) return x.clip < y.clip;
@@ -238,7 +250,7 @@ std::vector<FillMapping> search_fill_motion(const Clip& clip, const FillGap& gap
     const Query q = build_query(clip, gap, db.rate, o.window_s);
     if (q.frames < 2 || q.visible.empty()) return out;
     const int refine = std::max({1, o.refine_candidates, o.blend_matches});
-    for (const Candidate& c : distinct_best(coarse_search(q, db, o.velocity_weight), refine, q.frames)) {
+    for (const Candidate& c : distinct_best(coarse_search(q, db, o.velocity_weight, std::max(1, o.coarse_stride)), refine, q.frames)) {
         FillMapping m;
         m.query_t0 = q.t0;
         m.query_rate = db.rate;

@@ -100,12 +100,14 @@ TEST_CASE("fill: a hidden leg that truly follows a database clip is recovered al
     const FillDatabase db = prepare_fill_database({walker_clip("db", 0.0, 400)});
     // The input is the same motion 2.3 s later: the database holds it at frame 69.
     const Clip truth = walker_clip("input", 2.3, 150);
+    // 2 s, and 4 s (filled whole, then again in two pieces: piece_s 2 s).
+    for (const auto& [first, last] : {std::pair{40, 99}, std::pair{15, 134}})
     for (const char* hide : {"lfemur", "left_leg", "legs", "arms"}) {
         Clip input = truth;
         FillGap g;
         g.hidden = resolve_hidden_joints(input.skeleton, hide, "--hide");
-        g.first = 40;
-        g.last = 99;
+        g.first = first;
+        g.last = last;
         // What the file holds in the gap is ignored: zero it.
         for (int f = g.first; f <= g.last; ++f)
             for (int j = 0; j < input.joint_count(); ++j)
@@ -113,9 +115,12 @@ TEST_CASE("fill: a hidden leg that truly follows a database clip is recovered al
         FillOptions exact;
         exact.ease_s = 0.0;  // the border ease corrects toward the known velocity: off, to see the match itself
         const FillMatch m = fill_gap(input, g, &db, exact);
-        INFO(hide << ": matched at " << m.start_s << " s, scale " << m.scale << ", distance " << m.distance);
+        INFO(hide << ", frames " << first << ".." << last << ": matched at " << m.start_s << " s, scale " << m.scale << ", distance " << m.distance);
         REQUIRE(m.found);
-        CHECK(max_error(input, truth, 0, truth.frame_count - 1) < 1e-3);  // leg 30 units long
+        // Leg 30 units long. The 4 s gap's arms come back within 0.0014 (0.0012
+        // filled whole, without the pieces): the gap starts 0.5 s into the clip,
+        // where the matched window is cut short.
+        CHECK(max_error(input, truth, 0, truth.frame_count - 1) < (last - first > 60 ? 2e-3 : 1e-3));
         CHECK(visible_identical(truth, input, g));
         Clip slerped = truth;
         FillOptions so;
@@ -294,27 +299,26 @@ void check_targets(const char* group, const std::vector<double>& gaps, int trial
 
 }  // namespace
 
-// On the shared CMU subject-16 clips, leave-one-out, 2 gaps per clip and length
-// (docs/fill.md has the full table): what holds today. One leg meets all the
-// issue's targets; both legs meet the half-error target at 1 and 2 s (graph ≤ ½
-// slerp); both arms beat slerp at every length but not by half (docs/fill.md,
-// "Where it stands"). The worst border ratio is ≤ 2 for all three here.
-TEST_CASE("fill: on the CMU subject-16 clips graph beats slerp; legs meet the half-error target at 1 and 2 s", "[fill]") {
+// On the shared CMU subject-16 clips, leave-one-out (docs/fill.md has the full
+// table): what holds today. One leg and both legs meet all the issue's targets
+// (every length, 3 gaps per clip and length, graph ≤ ½ slerp from 1 s, the worst
+// border ratio ≤ 2); both arms beat slerp at every length but not by half
+// (docs/fill.md, "Where it stands"), 2 gaps per clip and length here.
+TEST_CASE("fill: on the CMU subject-16 clips graph beats slerp; legs and one leg meet every target", "[fill]") {
     if (test::mocap_dir().empty()) return;  // skipped without the shared data (fails under CI=true)
-    // One leg meets every target of the issue, as written (every length, 3 gaps per
-    // clip and length, the worst border ratio ≤ 2 at 4 s since the fill follows
-    // the smoothed parent), so it is checked here rather than in "[.fill-targets]".
+    // One leg since the fill follows the smoothed parent; both legs at 4 s since
+    // long gaps are filled again in pieces (docs/fill.md, step 10).
     check_targets("left_leg", {0.25, 0.5, 1.0, 2.0, 4.0}, 3, true, true);
-    check_targets("legs", {0.25, 1.0, 2.0}, 2, true, true);  // met at 1 and 2 s since the root-velocity point
+    check_targets("legs", {0.25, 0.5, 1.0, 2.0, 4.0}, 3, true, true);
     check_targets("arms", {0.25, 1.0, 2.0}, 2, false, true);
 }
 
-// The issue's targets as written, for every group and gap length (hidden: run with
-// `marionette_graph_tests "[.fill-targets]"`; legs miss the half-error target at
-// 4 s and arms at 1, 2 and 4 s, and arms the worst border ratio at 4 s (2.16,
-// where the truth's own move is 2.08), docs/fill.md).
-TEST_CASE("fill: the issue's targets for legs, arms and one leg at every gap length", "[.fill-targets]") {
+// The issue's targets as written for the arms, at every gap length (hidden: run
+// with `marionette_graph_tests "[.fill-targets]"`; the arms miss the half-error
+// target at 1, 2 and 4 s (0.59–0.67 of slerp) and the worst border ratio at 4 s
+// (2.16, where the truth's own move is 2.08), docs/fill.md).
+TEST_CASE("fill: the issue's targets for the arms at every gap length", "[.fill-targets]") {
     if (test::mocap_dir().empty()) return;  // skipped without the shared data (fails under CI=true)
-    // One leg meets them all: its check is in the CI test above.
-    for (const char* group : {"legs", "arms"}) check_targets(group, {0.25, 0.5, 1.0, 2.0, 4.0}, 3, true, true);
+    // One leg and both legs meet them all: their checks are in the CI test above.
+    check_targets("arms", {0.25, 0.5, 1.0, 2.0, 4.0}, 3, true, true);
 }
