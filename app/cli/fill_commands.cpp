@@ -25,6 +25,7 @@ using namespace marionette::offline;
 struct FillCommandOptions {
     std::string input, asf, output, method = "graph";
     std::vector<std::string> database, hide, frames;
+    double piece_s = FillOptions{}.piece_s;
     bool allow_self = false, json = false;
 };
 
@@ -33,8 +34,16 @@ struct FillEvalCommandOptions {
     std::vector<std::string> clips, database;
     std::uint64_t seed = 1;
     int trials = 3;
+    double piece_s = FillOptions{}.piece_s;
     bool json = false, per_clip = false, oracle_match = false;
 };
+
+// --piece: 0 (whole gaps only) or 0.25..60 s.
+double checked_piece_s(double s) {
+    if (!(s == 0.0 || (s >= 0.25 && s <= 60.0)))
+        throw ImportError("--piece", 0, fmt::format("{}: expected 0 (fill gaps whole only) or a piece length of 0.25 to 60 seconds", s));
+    return s;
+}
 
 Clip load_any_clip(const std::string& file, const std::string& asf) {
     const std::string ext = lower_extension(file);
@@ -92,6 +101,7 @@ int clip_fill_command(const FillCommandOptions& o) {
     Clip clip = load_any_clip(o.input, o.asf);
     FillOptions fo;
     fo.method = parse_fill_method(o.method, "--method");
+    fo.piece_s = checked_piece_s(o.piece_s);
     if (o.hide.size() != o.frames.size())
         throw ImportError("--hide", 0, fmt::format("{} --hide and {} --frames given: each --hide needs its --frames A:B",
                                                    o.hide.size(), o.frames.size()));
@@ -139,6 +149,7 @@ int clip_fill_eval_command(const FillEvalCommandOptions& o) {
     eo.gaps_s = parse_gaps(o.gaps);
     eo.seed = o.seed;
     eo.fill.oracle_match = o.oracle_match;
+    eo.fill.piece_s = checked_piece_s(o.piece_s);
     if (o.trials < 1 || o.trials > 1000) throw ImportError("--trials", 0, "expected 1..1000 gaps per clip and length");
     eo.trials = o.trials;
     std::vector<Clip> clips;
@@ -204,6 +215,7 @@ void register_clip_fill_commands(CLI::App* clip, int& exit_code) {
         ->required()->expected(1)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
     fill->add_option("--method", o->method, "graph (default), slerp or hold");
     fill->add_option("-o,--output", o->output, "output BVH")->required();
+    fill->add_option("--piece", o->piece_s, "graph: gaps longer than this many seconds are filled again in pieces this long (default 2; 0: whole only)");
     fill->add_flag("--allow-self", o->allow_self, "allow a database file with the input's content");
     fill->add_flag("--json", o->json, "print JSON");
     on_parsed(fill, exit_code, [o] { return clip_fill_command(*o); });
@@ -220,6 +232,7 @@ void register_clip_fill_commands(CLI::App* clip, int& exit_code) {
     eval->add_option("--trials", e->trials, "random gaps per clip and gap length (default 3)");
     eval->add_flag("--oracle-match", e->oracle_match,
                    "diagnosis: the graph method's search also sees the hidden joints' truth (the best match in hindsight)");
+    eval->add_option("--piece", e->piece_s, "as clip fill --piece (default 2; 0: whole only)");
     eval->add_flag("--per-clip", e->per_clip, "also report each clip's mean error per method and gap length");
     eval->add_flag("--json", e->json, "print JSON");
     on_parsed(eval, exit_code, [e] { return clip_fill_eval_command(*e); });

@@ -66,6 +66,15 @@ expect_error "a database skeleton with no humanoid is refused" 2 "chain.bvh: its
 expect_error "--hide without --frames is refused" 2 "each --hide needs its --frames" "$bin" clip fill "$m/16_15.amc" --asf "$asf" --database "${db[@]}" --hide legs --hide arms --frames 1:20 -o x.bvh
 expect_error "an unknown method is refused" 2 "unknown fill method 'spline'" "$bin" clip fill "$m/16_15.amc" --asf "$asf" --database "${db[@]}" --hide legs --frames 1:20 --method spline -o x.bvh
 expect_error "bad gap lengths are refused" 2 "--gaps" "$bin" clip fill-eval --asf "$asf" --clips "${db[@]}" --hide legs --gaps 1,x
+check "a 2.5 s gap is filled again in pieces (default --piece 2); --piece 0 fills it whole only, the visible channels the same" bash -c "'$bin' clip fill '$m/16_15.amc' --asf '$asf' --database ${db[*]} --hide legs --frames 100:399 -o p2.bvh >/dev/null && '$bin' clip fill '$m/16_15.amc' --asf '$asf' --database ${db[*]} --hide legs --frames 100:399 --piece 0 -o p0.bvh >/dev/null && ! cmp -s p2.bvh p0.bvh && python3 - p0.bvh p2.bvh <<'PY'
+import sys
+a = open(sys.argv[1]).read().split('MOTION')[1].split('\n')[3:]
+b = open(sys.argv[2]).read().split('MOTION')[1].split('\n')[3:]
+assert len(a) == len(b) and len(a) >= 471
+rows = [i for i in range(len(a)) if a[i] != b[i]]
+assert rows and min(rows) >= 100 and max(rows) <= 399, (rows[:3], rows[-3:])
+PY"
+expect_error "a bad --piece is refused" 2 "--piece: -1: expected 0 (fill gaps whole only) or a piece length of 0.25 to 60 seconds" "$bin" clip fill "$m/16_15.amc" --asf "$asf" --database "${db[@]}" --hide legs --frames 1:20 --piece -1 -o x.bvh
 
 echo "$passes passed, $failures failed"
 [[ $failures -eq 0 ]]
