@@ -20,6 +20,7 @@
 #include "runtime/formats/file_names.hpp"
 #include "runtime/gait/puppet.hpp"
 #include "runtime/math/det_math.hpp"
+#include "tests/seeded_random.hpp"
 #include "tests/test_support.hpp"
 
 using namespace marionette;
@@ -162,17 +163,7 @@ TEST_CASE("retarget: the puppet onto itself is the identity", "[retarget]") {
 
 namespace {
 
-struct Rng {
-    std::uint64_t s;
-    std::uint64_t next() {
-        std::uint64_t z = (s += 0x9e3779b97f4a7c15ull);
-        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-        return z ^ (z >> 31);
-    }
-    double uniform(double a, double b) { return a + (b - a) * static_cast<double>(next() >> 11) * 0x1.0p-53; }
-    int pick(int n) { return static_cast<int>(next() % static_cast<std::uint64_t>(n)); }
-};
+using Rng = test::SeededRandom;
 
 enum class Names { cmu_asf, cmu_bvh, mixamo, numbered };
 
@@ -210,12 +201,12 @@ struct Builder {
 Generated generate(std::uint64_t seed) {
     Rng rng{seed};
     Builder b;
-    b.names = static_cast<Names>(rng.pick(4));
+    b.names = static_cast<Names>(static_cast<int>(rng.below(4)));
     const float k = static_cast<float>(rng.uniform(0.4, 60.0));  // any unit: metres to inches and beyond
     const double arm_angle = rng.uniform(0.15, 1.75);             // from hanging (0) past T-pose (pi/2)
-    const bool hip_joints = rng.pick(2) == 0, toe_end_joint = rng.pick(2) == 0, fingers = rng.pick(2) == 0;
-    const bool standing = rng.pick(5) == 0;
-    const bool z_up = rng.pick(4) == 0;
+    const bool hip_joints = static_cast<int>(rng.below(2)) == 0, toe_end_joint = static_cast<int>(rng.below(2)) == 0, fingers = static_cast<int>(rng.below(2)) == 0;
+    const bool standing = static_cast<int>(rng.below(5)) == 0;
+    const bool z_up = static_cast<int>(rng.below(4)) == 0;
     const double yaw = rng.uniform(-3.14159, 3.14159);
     const int hips = b.add(b.name("root", "Hips"), kNoParent, vec3(0, 1.0f * k, 0));
     Generated g;
