@@ -134,7 +134,8 @@ std::vector<Candidate> coarse_search(const Query& q, const FillDatabase& db, dou
             const int last = db.clips[static_cast<size_t>(c)].frame_count - 1;
             for (double scale : kScales) {
                 const double span = (q.frames - 1) * scale;
-                for (int s = 0; s + span <= last + 1e-9; s += stride_frames) found[static_cast<size_t>(k)].push_back(score(q, sample, db, c, s, scale, b, w));
+                for (int s = 0; s + span <= last + 1e-9; s += stride_frames)
+                    found[static_cast<size_t>(k)].push_back(score(q, sample, db, c, s, scale, b, w));
             }
         }
     };

@@ -1214,9 +1214,10 @@ TwoBoneIkResult solve_limb(const TwoBoneIkJob& ik) { return solve_two_bone_ik(ik
 // pole's part perpendicular to the leg) but degenerates as the ankle nears hip
 // height ahead of it and flips the knee through 180° when the ankle passes
 // above: a swing foot over a riser or an uphill curb spun the shin at
-// thousands of degrees per second. The small forward part keeps the pole
-// defined for a leg pointing straight sideways and never changes a leg in the
-// sagittal plane (its projection is a positive multiple of the turned leg).
+// thousands of degrees per second. The forward part (half the leg's length)
+// keeps the pole defined for a leg pointing sideways, and never changes the
+// knee of a leg in the sagittal plane: shorter than the leg, it leaves the
+// pole's part perpendicular to the leg a positive multiple of the turned leg.
 vec3 knee_pole(const HeadingFrame& h, vec3 hip, vec3 ankle) {
     const vec3 leg = ankle - hip;
     const float ahead = dot3(leg, h.forward);
