@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "runtime/errors/import_error.hpp"
+#include "runtime/math/splitmix64.hpp"
 
 namespace marionette::firmware_sim {
 
@@ -103,13 +104,8 @@ std::string describe_faults(const FaultSpec& f) {
     return out;
 }
 
-std::uint64_t SimRandom::next_u64() {
-    std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-double SimRandom::uniform() { return static_cast<double>(next_u64() >> 11) * (1.0 / 9007199254740992.0); }
+std::uint64_t SimRandom::next_u64() { return splitmix64_next(state_); }
+double SimRandom::uniform() { return splitmix64_unit(state_); }
 double SimRandom::gaussian() {
     const double u1 = 1.0 - uniform(), u2 = uniform();
     return std::sqrt(-2.0 * std::log(u1)) * std::cos(6.283185307179586 * u2);

@@ -4,20 +4,16 @@
 #include <cmath>
 
 #include "runtime/errors/import_error.hpp"
+#include "runtime/math/splitmix64.hpp"
 
 namespace marionette::offline {
 
 namespace {
 
-// splitmix64 (Steele, Lea, Flood 2014): the gaps' positions, one stream per run.
+// The gaps' positions, one splitmix64 stream per run.
 struct SplitMix64 {
     std::uint64_t state;
-    std::uint64_t next() {
-        std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-        return z ^ (z >> 31);
-    }
+    std::uint64_t next() { return splitmix64_next(state); }
 };
 
 double distance(vec3 a, vec3 b) {

@@ -12,6 +12,7 @@
 #include "app/eval/gait_eval.hpp"
 #include "runtime/formats/stick_program.hpp"
 #include "runtime/ground/terrain.hpp"
+#include "runtime/math/splitmix64.hpp"
 #include "runtime/sim/sim_config.hpp"
 
 namespace marionette {
@@ -22,13 +23,8 @@ namespace marionette {
 class SweepRandom {
 public:
     explicit SweepRandom(std::uint64_t seed) : state_(seed) {}
-    std::uint64_t next() {
-        std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    }
-    double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }  // [0, 1)
+    std::uint64_t next() { return splitmix64_next(state_); }
+    double uniform() { return splitmix64_unit(state_); }  // [0, 1)
     double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
     // Inclusive range; the modulo bias is below 2^-32 for the small ranges used here.
     int integer(int lo, int hi) {

@@ -8,20 +8,13 @@
 #include <utility>
 
 #include "runtime/math/det_math.hpp"
+#include "runtime/math/splitmix64.hpp"
 
 namespace marionette {
 
 namespace {
 PlanarTransform placement(double angle, double dx, double dz) { return {angle, dx, dz}; }
 
-// splitmix64: a full-period 64-bit generator with one word of state.
-std::uint64_t next_random(std::uint64_t& state) {
-    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-double random_unit(std::uint64_t& state) { return static_cast<double>(next_random(state) >> 11) * (1.0 / 9007199254740992.0); }
 
 constexpr float kUnreachableSeconds = 1e9f;
 // Past this the heuristic stops growing: it only has to point the way.
@@ -308,7 +301,7 @@ int GraphController::random_edge(GraphControllerState& s) const {
     const double temperature = config_.attract_temperature > 0.0 ? config_.attract_temperature : 1.0;
     double total = 0.0;
     for (const GraphEdge& e : out) total += 1.0 / (1.0 + e.cost / temperature);
-    double pick = random_unit(s.rng) * total;
+    double pick = splitmix64_unit(s.rng) * total;
     for (const GraphEdge& e : out) {
         pick -= 1.0 / (1.0 + e.cost / temperature);
         if (pick < 0.0) return graph_.edge_index(e);

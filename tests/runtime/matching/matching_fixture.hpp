@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "runtime/math/det_math.hpp"
+#include "runtime/math/splitmix64.hpp"
 #include "runtime/matching/matching_database.hpp"
 
 namespace marionette::test {
@@ -32,13 +33,8 @@ struct MatchingFixture {
     }
 };
 
-inline std::uint64_t fixture_next(std::uint64_t& s) {
-    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-inline double fixture_unit(std::uint64_t& s) { return static_cast<double>(fixture_next(s) >> 11) * (1.0 / 9007199254740992.0); }
+inline std::uint64_t fixture_next(std::uint64_t& s) { return splitmix64_next(s); }
+inline double fixture_unit(std::uint64_t& s) { return splitmix64_unit(s); }
 
 inline MatchingFixture make_matching_fixture(int clips, int frames_per_clip, std::uint64_t seed) {
     MatchingFixture m;
