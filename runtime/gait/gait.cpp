@@ -4,6 +4,7 @@
 
 #include "runtime/gait/puppet.hpp"
 #include "runtime/gait/steering.hpp"
+#include "runtime/ground/obstacles.hpp"
 #include "runtime/anim/local_to_model.hpp"
 #include "runtime/anim/skeleton.hpp"
 #include "runtime/anim/two_bone_ik.hpp"
@@ -111,6 +112,10 @@ constexpr float kToeMarginM = 0.025f;
 constexpr float kEdgeDropM = 0.02f;      // ground this far below the sole plane is past an edge
 constexpr float kFitTolerance = 0.004f;  // m of misfit a spot may have
 constexpr float kSpotSearchStepM = 0.005f;
+constexpr float kSettledM = 1e-4f;            // m: an idle root this close to the middle of its feet has settled
+constexpr float kObstacleTopProbeM = 0.005f;  // m below a spot's ground: inside the box it stands on
+constexpr int kObstacleSearchSteps = 20;      // spots tried between a spot on an obstacle and the walkable side
+constexpr float kWallFootClearanceM = 0.06f;  // m a planted foot keeps from a wall's face (the swing swings out 1–3 cm)
 constexpr int kSpotSearchSteps = 34;     // on each side: up to 17 cm along the heading
 
 // A planted foot at (x, z): sole on the surface, aligned to the normal there and
@@ -330,6 +335,13 @@ void build_swing_path(FootState& f, const Terrain& whole_terrain, const GaitRig&
             const vec3 forward = quat_rotate(q, vec3(0.0f, 0.0f, 1.0f));
             for (float r : {rig.foot_length, rig.foot_length + rig.toe_length})
                 h = maxf(h, query_ground(terrain, a.x + forward.x * r, a.z + forward.z * r).height);
+            // The toe tip swung out sideways too: a foot lifting beside a riser
+            // its toes point at, 1 cm from its edge, swung them into it (sweep
+            // case 13-0408, 145 mm).
+            const vec3 tip = a + forward * (rig.foot_length + rig.toe_length);
+            if (side > 0.0f)
+                for (const vec2& d : {vec2(side, 0.0f), vec2(-side, 0.0f), vec2(0.0f, side), vec2(0.0f, -side)})
+                    h = maxf(h, query_ground(terrain, tip.x + d.x, tip.z + d.y).height);
             // A foot pitched toes-down (landing on a ramp below it) carries its
             // ball and toe tip below the sole under the ankle: the ankle must
             // clear the ground under them by that much more.
@@ -403,6 +415,43 @@ void build_swing_path(FootState& f, const Terrain& whole_terrain, const GaitRig&
 float swing_reach_bump(float progress, float carry) {
     const float u = clampf(progress, 0.0f, 1.0f);
     return maxf(4.0f * u * (1.0f - u), carry * (1.0f - u));
+}
+
+// Whether a planted foot there would stand on top of an obstacle (a wall's top,
+// not a stair tread) or within kWallFootClearanceM of one's face: around its
+// ankle and toe tip, ground more than max_step_height above its sole, or ground
+// that is the top of a box whose faces rise more than max_step_height.
+bool on_obstacle(const Terrain& terrain, const GaitRig& rig, const Placement& p, float max_step_height) {
+    const vec3 tip = p.ankle + quat_rotate(p.rotation, vec3(0.0f, -rig.ankle_height, rig.foot_length + rig.toe_length));
+    for (const vec3& q : {p.ankle, tip})
+        for (const vec2& d : {vec2(0.0f, 0.0f), vec2(kWallFootClearanceM, 0.0f), vec2(-kWallFootClearanceM, 0.0f),
+                              vec2(0.0f, kWallFootClearanceM), vec2(0.0f, -kWallFootClearanceM)}) {
+            const float x = q.x + d.x, z = q.z + d.y;
+            const float h = query_ground(terrain, x, z).height;
+            // Ground more than a step above the sole within the clearance: a
+            // wall's face (the swing path would climb it); on a wall's top: the
+            // top itself.
+            if (h > p.ground + max_step_height) return true;
+            if (obstacle_depth(terrain, vec3(x, h - kObstacleTopProbeM, z), max_step_height) > 0.0f) return true;
+        }
+    return false;
+}
+
+// A foot's spot kept off obstacles: a spot on one moves toward `toward` (a spot
+// known to be on the walkable side: beside the planted foot, under the root) to
+// the first spot that fits and is off every obstacle. Stop and turning steps
+// are placed beside a foot or the root, and a foot planted near a wall while
+// approaching it put its neighbour's stop step on the wall's top (sweep case
+// 3-0001, a 2.16 m wall).
+Placement keep_off_obstacles(const Terrain& terrain, const GaitRig& rig, const Placement& placed, vec3 spot, vec3 toward,
+                             vec3 forward, float max_step_height) {
+    if (!on_obstacle(terrain, rig, placed, max_step_height)) return placed;
+    for (int k = 1; k <= kObstacleSearchSteps; ++k) {
+        const vec3 at = lerp(spot, toward, static_cast<float>(k) / static_cast<float>(kObstacleSearchSteps));
+        const Placement candidate = place_foot_on_flat_spot(terrain, rig, at.x, at.z, forward);
+        if (!on_obstacle(terrain, rig, candidate, max_step_height)) return candidate;
+    }
+    return place_foot_on_flat_spot(terrain, rig, toward.x, toward.z, forward);
 }
 
 // Starts (or re-aims) a swing from where the foot is now toward a planted target.
@@ -566,7 +615,10 @@ Placement plan_target(const GaitState& g, const GaitTick& t, int foot, vec3 root
     const double yaw = det::atan2(toes.x, toes.z);
     const double facing = yaw + clamp_magnitude(det::wrap_angle(static_cast<double>(p.mid_stance.heading) - yaw),
                                                 max_foot_turn(p.time));
-    return place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, heading_frame(facing).forward);
+    const vec3 forward = heading_frame(facing).forward;
+    const vec3 hip_now = root + t.h.left * (side_sign(foot) * t.rig.hip_half_width);
+    return keep_off_obstacles(t.terrain, t.rig, place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, forward), spot,
+                              hip_now, forward, t.c.max_step_height);
 }
 
 constexpr float kShortestSwing = 0.12f;           // s: a late lift-off still swings this long
@@ -575,11 +627,13 @@ constexpr float kWristDrag = 0.4f;                // hand tilt against its path'
 constexpr float kMaxPelvisVerticalSpeed = 0.9f;   // m/s the pelvis follows its height target at, at most
 
 // Standing spot for a foot beside the other (planted) foot.
-Placement stop_target(const GaitState& g, int foot, float heading, const GaitRig& rig, const Terrain& terrain) {
+Placement stop_target(const GaitState& g, int foot, float heading, const GaitRig& rig, const Terrain& terrain,
+                      float max_step_height) {
     const HeadingFrame h = heading_frame(heading);
     const vec3 other = g.feet[static_cast<std::size_t>(1 - foot)].ankle;
     const vec3 spot = other + h.left * (side_sign(foot) * 2.0f * rig.hip_half_width);
-    return place_foot_on_flat_spot(terrain, rig, spot.x, spot.z, h.forward);
+    return keep_off_obstacles(terrain, rig, place_foot_on_flat_spot(terrain, rig, spot.x, spot.z, h.forward), spot, other,
+                              h.forward, max_step_height);
 }
 
 }  // namespace
@@ -840,7 +894,7 @@ void start_stopping(GaitState& g, const GaitTick& t, vec3 root) {
         // In a flight phase neither foot is down to stand beside: both go under their hips.
         const vec3 spot = root + t.h.left * (side_sign(i) * t.rig.hip_half_width);
         const Placement p = other.swinging ? place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, t.h.forward)
-                                           : stop_target(g, i, t.heading, t.rig, t.terrain);
+                                           : stop_target(g, i, t.heading, t.rig, t.terrain, t.c.max_step_height);
         // Short, but never faster than kMaxStopFootSpeed for the foot, nor
         // turning faster than kMaxFootTurnDegS on average.
         const float time = maxf(clampf(maxf(remaining, horizontal_distance(f.ankle, p.ankle) / kMaxStopFootSpeed), kMinStopSwingS,
@@ -873,7 +927,9 @@ Placement aim_swing(const GaitState& g, const GaitTick& t, vec3 root, int i, flo
     const vec3 toes = quat_rotate(g.feet[static_cast<std::size_t>(i)].rotation, vec3(0.0f, 0.0f, 1.0f));
     const double yaw = det::atan2(toes.x, toes.z);
     const double facing = yaw + clamp_magnitude(det::wrap_angle(heading_then - yaw), max_turn);
-    return place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, heading_frame(facing).forward);
+    const vec3 forward = heading_frame(facing).forward;
+    return keep_off_obstacles(t.terrain, t.rig, place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, forward), spot, root,
+                              forward, t.c.max_step_height);
 }
 
 // The shortest a phase-driven swing may take: kShortestSwing, and its travel
@@ -1036,7 +1092,7 @@ void finish_stopping(GaitState& g, const GaitTick& t) {
     if (std::fabs(along) > kStopStaggerM) {
         const int trailing = along < 0.0f ? 0 : 1;
         FootState& f = g.feet[static_cast<std::size_t>(trailing)];
-        const Placement p = stop_target(g, trailing, t.heading, t.rig, t.terrain);
+        const Placement p = stop_target(g, trailing, t.heading, t.rig, t.terrain, t.c.max_step_height);
         const float time = maxf(maxf(kMinClosingStepS, t.c.stop_transition_s * kClosingStepStretch), turn_time(f.rotation, p.rotation));
         begin_swing(f, p, t.terrain, t.rig, t.c, g.run_blend, 0.0f, 1.0f / time);
         evaluate_swing(f, trailing, t.c, t.rig, g.run_blend, t.h.left);
@@ -1064,6 +1120,13 @@ void settle_root(GaitState& g, const GaitTick& t, vec3& root) {
     const float ground_mean = 0.5f * (g.feet[0].ground + g.feet[1].ground);
     g.pelvis_base = approach(g.pelvis_base, ground_mean, t.c.interpolation_rate * kPelvisBaseRateScale, t.dt);
     root.y = g.pelvis_base;
+}
+
+// Whether an idle root still moves toward the middle of its feet (settle_root).
+bool root_settling(const GaitState& g, vec3 root) {
+    if (g.mode != GaitMode::idle) return false;
+    const vec3 mid = 0.5f * (g.feet[0].ankle + g.feet[1].ankle);
+    return std::fabs(mid.x - root.x) > kSettledM || std::fabs(mid.z - root.z) > kSettledM;
 }
 
 // The pelvis before the reach limits: over the root, at the pelvis base plus
@@ -1178,7 +1241,10 @@ void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const
                  const GaitRig& rig, const Terrain& terrain) {
     const float dt = in.dt;
     const StickCommand cmd = read_stick(in, c, heading);
-    const NearbyWalls walls = cmd.moving ? find_nearby_walls(terrain, c, root) : NearbyWalls{};
+    // Walls matter while the root moves: steered, or settling between the feet.
+    const bool root_may_move = cmd.moving || g.mode != GaitMode::idle || root_settling(g, root);
+    const NearbyWalls walls = root_may_move ? find_nearby_walls(terrain, c, root) : NearbyWalls{};
+    const float from_x = root.x, from_z = root.z;
     const StanceReach reach = stance_reach(g, root, heading, rig);
     const Steering s = steer(g, heading, root, cmd, walls, c, terrain, dt);
     const HeadingFrame h = heading_frame(heading);
@@ -1194,6 +1260,7 @@ void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const
     finish_stopping(g, t);
     count_flight_phases(g);
     settle_root(g, t, root);
+    keep_root_out_of_walls(walls, from_x, from_z, root.x, root.z);
     place_pelvis(g, t, root, in.breath_time);
     lean_with_speed(g, c, dt);
 }

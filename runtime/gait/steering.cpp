@@ -96,6 +96,23 @@ float turn_speed_cap(double abs_diff, float goal_speed, const GaitConfig& c) {
 
 }  // namespace
 
+void keep_root_out_of_walls(const NearbyWalls& walls, float from_x, float from_z, float& x, float& z) {
+    float dx = x - from_x, dz = z - from_z;
+    for (int pass = 0; pass < 2; ++pass)  // twice, for inside corners
+        for (int i = 0; i < walls.count; ++i) {
+            const Nearest n = nearest_on_box(walls.boxes[static_cast<std::size_t>(i)], from_x, from_z);
+            if (n.distance <= 0.0f) continue;
+            const float allowed = n.distance > kWallStandOffM ? n.distance - kWallStandOffM : 0.0f;
+            const float toward = -(dx * n.nx + dz * n.nz);
+            if (toward > allowed) {
+                dx += n.nx * (toward - allowed);
+                dz += n.nz * (toward - allowed);
+            }
+        }
+    x = from_x + dx;
+    z = from_z + dz;
+}
+
 float brake_deceleration(const GaitConfig& c) { return c.acceleration > kMinBrakeM_s2 ? c.acceleration : kMinBrakeM_s2; }
 
 NearbyWalls find_nearby_walls(const Terrain& terrain, const GaitConfig& c, vec3 root) {

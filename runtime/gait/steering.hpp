@@ -66,4 +66,10 @@ float brake_deceleration(const GaitConfig& c);
 // heading and moves the root.
 SteerResult steer_root(RootMotion& m, const SteerGoal& goal, const NearbyWalls& walls, const GaitConfig& c, float dt);
 
+// The root's whole move this tick (steering, the stance reach, an idle root
+// settling between the feet), from (from_x, from_z) to (x, z), less what takes it
+// further inside kWallStandOffM of a wall face than it was: the stand-off holds
+// for every way the root moves, not only for the steered velocity.
+void keep_root_out_of_walls(const NearbyWalls& walls, float from_x, float from_z, float& x, float& z);
+
 }  // namespace marionette
