@@ -116,6 +116,8 @@ constexpr float kSettledM = 1e-4f;            // m: an idle root this close to t
 constexpr float kObstacleTopProbeM = 0.005f;  // m below a spot's ground: inside the box it stands on
 constexpr int kObstacleSearchSteps = 20;      // spots tried between a spot on an obstacle and the walkable side
 constexpr float kWallFootClearanceM = 0.06f;  // m a planted foot keeps from a wall's face (the swing swings out 1–3 cm)
+constexpr int kRiseSearchSteps = 40;          // spots tried between a step that rises too far and the planted foot
+constexpr float kMaxStrideRiseShare = 0.52f;  // of the leg: the most a step rises or drops from the planted foot (0.45 m)
 constexpr int kSpotSearchSteps = 34;     // on each side: up to 17 cm along the heading
 
 // A planted foot at (x, z): sole on the surface, aligned to the normal there and
@@ -454,6 +456,28 @@ Placement keep_off_obstacles(const Terrain& terrain, const GaitRig& rig, const P
     return place_foot_on_flat_spot(terrain, rig, toward.x, toward.z, forward);
 }
 
+// A step kept within `max_rise` of the planted foot's ground: a spot rising or
+// dropping more moves back toward `beside` (the spot beside the planted foot)
+// to the farthest spot that fits, is off obstacles and is within it (the
+// nearest in rise if none is). A stride that took three or four stair risers
+// at once (walking at 0.8 m/s after a turn on 22 cm stairs, running down a
+// flight) folded the higher leg to 0.11 m hip–ankle and whipped its thigh and
+// foot past 2,000 °/s; one or two risers a step is what a person takes.
+Placement keep_within_rise(const Terrain& terrain, const GaitRig& rig, const Placement& placed, vec3 spot, vec3 beside,
+                           vec3 forward, float planted_ground, float max_rise, float max_step_height) {
+    if (std::fabs(placed.ground - planted_ground) <= max_rise) return placed;
+    Placement nearest = placed;
+    for (int k = 1; k <= kRiseSearchSteps; ++k) {
+        const vec3 at = lerp(spot, beside, static_cast<float>(k) / static_cast<float>(kRiseSearchSteps));
+        const Placement candidate = place_foot(terrain, rig, at.x, at.z, forward);
+        if (candidate.misfit >= kFitTolerance || on_obstacle(terrain, rig, candidate, max_step_height)) continue;
+        const float rise = std::fabs(candidate.ground - planted_ground);
+        if (rise < std::fabs(nearest.ground - planted_ground)) nearest = candidate;
+        if (rise <= max_rise) break;
+    }
+    return nearest;
+}
+
 // Starts (or re-aims) a swing from where the foot is now toward a planted target.
 void begin_swing(FootState& f, const Placement& target, const Terrain& terrain, const GaitRig& rig, const GaitConfig& c,
                  float blend, float lift_phase, float timed_rate) {
@@ -617,8 +641,13 @@ Placement plan_target(const GaitState& g, const GaitTick& t, int foot, vec3 root
                                                 max_foot_turn(p.time));
     const vec3 forward = heading_frame(facing).forward;
     const vec3 hip_now = root + t.h.left * (side_sign(foot) * t.rig.hip_half_width);
-    return keep_off_obstacles(t.terrain, t.rig, place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, forward), spot,
-                              hip_now, forward, t.c.max_step_height);
+    const Placement placed = keep_off_obstacles(t.terrain, t.rig, place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, forward),
+                                                spot, hip_now, forward, t.c.max_step_height);
+    const FootState& other = g.feet[static_cast<std::size_t>(1 - foot)];
+    if (other.swinging) return placed;
+    const vec3 beside = other.ankle + then.left * (side_sign(foot) * 2.0f * t.rig.hip_half_width);
+    return keep_within_rise(t.terrain, t.rig, placed, spot, beside, forward, other.ground,
+                            kMaxStrideRiseShare * (t.rig.thigh + t.rig.shin), t.c.max_step_height);
 }
 
 constexpr float kShortestSwing = 0.12f;           // s: a late lift-off still swings this long

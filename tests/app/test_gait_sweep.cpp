@@ -475,3 +475,21 @@ TEST_CASE("gait sweep regressions: the body and feet stay out of walls beside th
         CHECK(m.foot_skate_mm < kMaxFootSkateMm);
     }
 }
+
+// A step rises or drops at most 0.52 of the leg (0.45 m) from the planted
+// foot's ground (gait10): a stride of three or four risers folded the higher
+// leg to the hip. Joint speed before (main 57debb2, °/s): 4-0125 7,773,
+// 11-0479 3,827, 3-0183 3,140, 10-0487 2,519, 9-0131 2,416, 4-0289 2,162,
+// 13-0274 2,140 (stairs), 5-0185 2,060 (curbs) — 27 of the 6,000 cases of
+// seeds 3–6 and 8–15 fixed, 3 broken (1,528–1,704 °/s).
+TEST_CASE("gait sweep regressions: no stride of three or four risers, no folded leg", "[gait_sweep]") {
+    const SimConfig& config = shipped_config();
+    for (const SweepRegression r : {SweepRegression{4, 125}, SweepRegression{11, 479}, SweepRegression{3, 183},
+                                    SweepRegression{10, 487}, SweepRegression{9, 131}, SweepRegression{4, 289},
+                                    SweepRegression{13, 274}, SweepRegression{5, 185}}) {
+        const SweepCase c = generate_sweep_case(r.seed, r.index, config);
+        const SweepCaseResult result = evaluate_sweep_case(c, config);
+        INFO(c.id << ": " << c.description << ": " << result.problem);
+        CHECK(result.problem.empty());
+    }
+}

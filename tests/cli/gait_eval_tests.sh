@@ -64,7 +64,11 @@ if broken:
     # Walking programs never fly; the run program must (unless a wall stops it).
     if [[ $program == slow_walk || $program == fast_walk ]] && [[ $(field flight_phases) != 0 ]]; then
       echo "FAILED: $terrain $program: a walk has flight phases"; failures=$((failures + 1)); fi
-    if [[ $program == run && $walls == no ]] && [[ $(field flight_phases) -lt 10 ]]; then
+    # On building_stairs the climb cap (0.6 m/s of rise, docs/gait.md) holds the
+    # run to 0.93 m/s on its 18 cm / 28 cm flights, a walk: it runs (and flies)
+    # only on the landings and the approach, so there it must fly at all.
+    least_flights=10; [[ $terrain == building_stairs ]] && least_flights=1
+    if [[ $program == run && $walls == no ]] && [[ $(field flight_phases) -lt $least_flights ]]; then
       echo "FAILED: $terrain $program: running without flight phases"; failures=$((failures + 1)); fi
   done
 done
