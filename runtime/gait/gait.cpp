@@ -793,6 +793,8 @@ constexpr float kClosingStepStretch = 1.5f;        // … and otherwise this man
 constexpr float kFullActivitySpeed = 1.0f;         // m/s at which bob and arm swing reach full amplitude
 constexpr float kPelvisBaseRateScale = 1.5f;       // the pelvis base follows the ground this much faster than interpolation_rate
 constexpr float kFullLegReachShare = 0.995f;       // mid-swing the hip may be this share of thigh + shin from the ankle
+constexpr float kFarSwingM = 0.6f;                 // m: a swinging ankle this far from its hip (horizontally) is left behind …
+constexpr float kStanceFloorShare = 0.35f;         // … and its reach lowers the pelvis to this share of the leg above a planted ankle, no lower
 constexpr float kMinHipDropShareSq = 0.09f;        // the hip stays at least 0.3 of the reach (squared: 0.09) above the ankle
 constexpr float kEarlyLiftPhase = 0.05f;          // … at most this much of a cycle before its duty factor
 constexpr float kEarlyLiftReachShare = 0.9f;      // a planted foot this share of the leg reach behind its hip lifts
@@ -1200,9 +1202,11 @@ vec3 hip_at_landing_in_reach(const FootState& f, const GaitState& g, const GaitT
 float hip_drop(float horizontal2, float reach2) { return std::sqrt(maxf(reach2 - horizontal2, kMinHipDropShareSq * reach2)); }
 
 struct PelvisLimits {
-    float hard = kNoLimitM;  // m: keeps every ankle within its reach now
-    float soft = kNoLimitM;  // m: keeps each swing's landing within the planted reach
-    float descent = 0.0f;    // m/s: how fast the pelvis must sink to meet the soft limit by the swing's landing
+    float hard = kNoLimitM;        // m: keeps every planted ankle (and every swinging one near its hip) within its reach now
+    float far_swing = kNoLimitM;   // m: keeps the swinging ankles far from their hips within reach now
+    float soft = kNoLimitM;        // m: keeps each swing's landing within the planted reach
+    float descent = 0.0f;          // m/s: how fast the pelvis must sink to meet the soft limit by the swing's landing
+    float floor = -kNoLimitM;      // m: the lowest far_swing may take it (kStanceFloorShare over a planted ankle)
 };
 
 // Planted feet bind exactly (within the IK's exact zone). A swinging foot binds
@@ -1221,12 +1225,15 @@ PelvisLimits pelvis_limits(const GaitState& g, const GaitTick& t, vec3 pelvis) {
         const float dx = f.ankle.x - hip.x, dz = f.ankle.z - hip.z;
         if (!f.swinging) {
             limit.hard = minf(limit.hard, f.ankle.y + hip_drop(dx * dx + dz * dz, reach2));
+            limit.floor = maxf(limit.floor, f.ankle.y + kStanceFloorShare * (rig.thigh + rig.shin));
             continue;
         }
         // The planted reach at lift-off and landing, the full leg mid-swing, so
         // neither lifting nor landing changes the limit in one tick.
         const float swing_reach = rig.leg_reach + (full_reach - rig.leg_reach) * swing_reach_bump(f.progress, f.reach_carry);
-        limit.hard = minf(limit.hard, f.ankle.y + hip_drop(dx * dx + dz * dz, swing_reach * swing_reach));
+        const float swing_limit = f.ankle.y + hip_drop(dx * dx + dz * dz, swing_reach * swing_reach);
+        if (dx * dx + dz * dz > kFarSwingM * kFarSwingM) limit.far_swing = minf(limit.far_swing, swing_limit);
+        else limit.hard = minf(limit.hard, swing_limit);
         const vec3 hip_then = hip_at_landing_in_reach(f, g, t, pelvis, i);
         const float tx = f.target.x - hip_then.x, tz = f.target.z - hip_then.z;
         const float soft = f.target.y + hip_drop(tx * tx + tz * tz, reach2);
@@ -1251,6 +1258,12 @@ void place_pelvis(GaitState& g, const GaitTick& t, vec3 root, float breath_time)
     const float max_sink = maxf(kMaxPelvisVerticalSpeed, limit.descent) * t.dt;
     pelvis.y = minf(pelvis.y, limit.soft);
     pelvis.y = clampf(pelvis.y, previous_y - max_sink, previous_y + max_move);
+    // A swinging foot left far behind (a swing stranded at its lift-off spot
+    // a metre back and below while the root runs on across a hillside) pulled
+    // the pelvis down to the planted ankle, and that leg's thigh flipped at
+    // 8,600 °/s (10-0441, 13-0316): its reach lowers the pelvis no further than
+    // kStanceFloorShare of the leg above a planted ankle; its own leg stretches.
+    pelvis.y = maxf(minf(pelvis.y, limit.far_swing), minf(pelvis.y, limit.floor));
     pelvis.y = minf(pelvis.y, limit.hard);
     g.pelvis = pelvis;
 }
