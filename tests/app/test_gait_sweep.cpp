@@ -290,14 +290,26 @@ struct SweepRegression {
     std::uint64_t seed;
     int index;
 };
-void check_sweep_regressions(std::initializer_list<SweepRegression> cases, bool skate, bool penetration) {
+// The limits a kept case is held to.
+struct Held {
+    bool skate = false;
+    bool penetration = false;
+    bool obstacle = false;
+    double joint_speed_deg_s = 0.0;  // > 0: the joint speed is held under this
+    bool every_limit = false;        // the sweep's own verdict: no limit broken
+};
+void check_sweep_regressions(std::initializer_list<SweepRegression> cases, Held held) {
     const SimConfig& config = shipped_config();
     for (const SweepRegression& r : cases) {
         const SweepCase c = generate_sweep_case(r.seed, r.index, config);
-        INFO(c.id << ": " << c.description);
-        const GaitMetrics m = evaluate_sweep_case(c, config).metrics;
-        if (skate) CHECK(m.foot_skate_mm < kMaxFootSkateMm);
-        if (penetration) CHECK(m.penetration_mm < kMaxPenetrationMm);
+        const SweepCaseResult result = evaluate_sweep_case(c, config);
+        INFO(c.id << ": " << c.description << ": " << result.problem);
+        const GaitMetrics& m = result.metrics;
+        if (held.skate) CHECK(m.foot_skate_mm < kMaxFootSkateMm);
+        if (held.penetration) CHECK(m.penetration_mm < kMaxPenetrationMm);
+        if (held.obstacle) CHECK(m.obstacle_penetration_mm < kMaxObstaclePenetrationMm);
+        if (held.joint_speed_deg_s > 0.0) CHECK(m.max_joint_speed_deg_s < held.joint_speed_deg_s);
+        if (held.every_limit) CHECK(result.problem.empty());
     }
 }
 }  // namespace
@@ -309,7 +321,7 @@ void check_sweep_regressions(std::initializer_list<SweepRegression> cases, bool 
 TEST_CASE("gait sweep regressions: a stranded swing re-aims, no stance foot slides", "[gait_sweep]") {
     check_sweep_regressions({{7, 12}, {7, 47}, {7, 81}, {7, 162}, {7, 231}, {7, 239}, {7, 398}, {7, 416}, {7, 493},
                              {7, 592}, {7, 638}, {7, 699}, {7, 826}, {7, 954}, {1, 208}, {1, 254}, {1, 282}},
-                            true, false);
+                            {.skate = true});
 }
 
 // The pelvis sinks in time for a swing's landing (issue 13, branch gaitsweep):
@@ -320,16 +332,8 @@ TEST_CASE("gait sweep regressions: a stranded swing re-aims, no stance foot slid
 // (°/s): hillside 7-0409 1912, 1-0257 2994; stairs 7-0488 3248, 7-0644 3312;
 // curbs 7-0226 2895, 1-0100 2577.
 TEST_CASE("gait sweep regressions: the pelvis sinks in time for a landing, no shin spins", "[gait_sweep]") {
-    const SimConfig& config = shipped_config();
-    for (const SweepRegression r : {SweepRegression{7, 409}, SweepRegression{1, 257}, SweepRegression{7, 488},
-                                    SweepRegression{7, 644}, SweepRegression{7, 226}, SweepRegression{1, 100}}) {
-        const SweepCase c = generate_sweep_case(r.seed, r.index, config);
-        INFO(c.id << ": " << c.description);
-        const GaitMetrics m = evaluate_sweep_case(c, config).metrics;
-        CHECK(m.max_joint_speed_deg_s < kMaxJointSpeedDegS);
-        CHECK(m.foot_skate_mm < kMaxFootSkateMm);
-        CHECK(m.penetration_mm < kMaxPenetrationMm);
-    }
+    check_sweep_regressions({{7, 409}, {1, 257}, {7, 488}, {7, 644}, {7, 226}, {1, 100}},
+                            {.skate = true, .penetration = true, .joint_speed_deg_s = kMaxJointSpeedDegS});
 }
 
 // A foot turns and swings in the time its turn and travel need (issue 13,
@@ -341,24 +345,15 @@ TEST_CASE("gait sweep regressions: the pelvis sinks in time for a landing, no sh
 // 1638, 1-0238 1705, 1-0155 1921, 7-0009 1594, 7-0942 1769, 7-0588 1923,
 // 1-0125 1568 °/s).
 TEST_CASE("gait sweep regressions: a foot's turn and travel get their time, no foot or shin spins", "[gait_sweep]") {
-    const SimConfig& config = shipped_config();
-    for (const SweepRegression r : {SweepRegression{1, 71}, SweepRegression{7, 12}, SweepRegression{7, 289},
-                                    SweepRegression{7, 877}, SweepRegression{7, 144}, SweepRegression{1, 205},
-                                    SweepRegression{1, 238}, SweepRegression{1, 155}, SweepRegression{7, 9},
-                                    SweepRegression{7, 942}, SweepRegression{7, 588}, SweepRegression{1, 125}}) {
-        const SweepCase c = generate_sweep_case(r.seed, r.index, config);
-        INFO(c.id << ": " << c.description);
-        const GaitMetrics m = evaluate_sweep_case(c, config).metrics;
-        CHECK(m.max_joint_speed_deg_s < kMaxJointSpeedDegS);
-        CHECK(m.foot_skate_mm < kMaxFootSkateMm);
-        CHECK(m.penetration_mm < kMaxPenetrationMm);
-    }
+    check_sweep_regressions({{1, 71}, {7, 12}, {7, 289}, {7, 877}, {7, 144}, {1, 205}, {1, 238}, {1, 155}, {7, 9},
+                             {7, 942}, {7, 588}, {1, 125}},
+                            {.skate = true, .penetration = true, .joint_speed_deg_s = kMaxJointSpeedDegS});
 }
 
 // A swing path ramps toward a high key (branch gaitstairs): 1-0121 put a toe
 // 5.4 mm into a tread before.
 TEST_CASE("gait sweep regressions: the swing path clears the next tread", "[gait_sweep]") {
-    check_sweep_regressions({{1, 121}}, false, true);
+    check_sweep_regressions({{1, 121}}, {.penetration = true});
 }
 
 // Running up 21 cm / 28 cm stairs at 54° off their axis, the swing's ankle
@@ -366,7 +361,7 @@ TEST_CASE("gait sweep regressions: the swing path clears the next tread", "[gait
 // on main, 153 mm on branch gait3); a swing aimed for the time it takes (branch
 // gait4) lands clear: 0.0009 mm.
 TEST_CASE("gait sweep regressions: 7-0080, no toe inside a riser running up stairs at an angle", "[gait_sweep]") {
-    check_sweep_regressions({{7, 80}}, false, true);
+    check_sweep_regressions({{7, 80}}, {.penetration = true});
 }
 
 // A swing held to its travel at 4 m/s that outlasts its phase is aimed for its
@@ -374,17 +369,9 @@ TEST_CASE("gait sweep regressions: 7-0080, no toe inside a riser running up stai
 // gait4): every case of `--sweep 300 --seed 2` that failed on main and passes
 // now meets every limit (2-0122: 5,352 °/s on main).
 TEST_CASE("gait sweep regressions: seed 2's cases fixed by the gait3 and gait4 changes meet every limit", "[gait_sweep]") {
-    const SimConfig& config = shipped_config();
-    for (const SweepRegression r : {SweepRegression{2, 4}, SweepRegression{2, 13}, SweepRegression{2, 30},
-                                    SweepRegression{2, 56}, SweepRegression{2, 63},
-                                    SweepRegression{2, 87}, SweepRegression{2, 97}, SweepRegression{2, 122},
-                                    SweepRegression{2, 169}, SweepRegression{2, 171}, SweepRegression{2, 184},
-                                    SweepRegression{2, 211}, SweepRegression{2, 242}, SweepRegression{2, 263}}) {
-        const SweepCase c = generate_sweep_case(r.seed, r.index, config);
-        const SweepCaseResult result = evaluate_sweep_case(c, config);
-        INFO(c.id << ": " << c.description << ": " << result.problem);
-        CHECK(result.problem.empty());
-    }
+    check_sweep_regressions({{2, 4}, {2, 13}, {2, 30}, {2, 56}, {2, 63}, {2, 87}, {2, 97}, {2, 122}, {2, 169},
+                             {2, 171}, {2, 184}, {2, 211}, {2, 242}, {2, 263}},
+                            {.every_limit = true});
 }
 
 // A stranded swing is judged by the spot it would really be re-aimed at (the
@@ -399,35 +386,17 @@ TEST_CASE("gait sweep regressions: seed 2's cases fixed by the gait3 and gait4 c
 // 7-0495 1782, 7-0512 3696, 7-0564 3147, 7-0680 2032, 7-0684 2247, 7-0797 2607,
 // 7-0918 3146, 7-0950 2909, 7-0956 1557.
 TEST_CASE("gait sweep regressions: a stranded swing does not re-aim every tick and no foot enters a tread", "[gait_sweep]") {
-    const SimConfig& config = shipped_config();
-    for (const SweepRegression r : {SweepRegression{2, 52}, SweepRegression{7, 655}}) {
-        const SweepCase c = generate_sweep_case(r.seed, r.index, config);
-        const SweepCaseResult result = evaluate_sweep_case(c, config);
-        INFO(c.id << ": " << c.description << ": " << result.problem);
-        CHECK(result.metrics.penetration_mm < kMaxPenetrationMm);
-        CHECK(result.problem.empty());
-    }
-    for (const SweepRegression r : {SweepRegression{1, 62}, SweepRegression{1, 91}, SweepRegression{1, 265},
-                                    SweepRegression{2, 227}, SweepRegression{7, 220}, SweepRegression{7, 495},
-                                    SweepRegression{7, 512}, SweepRegression{7, 564}, SweepRegression{7, 680},
-                                    SweepRegression{7, 684}, SweepRegression{7, 797}, SweepRegression{7, 918},
-                                    SweepRegression{7, 950}, SweepRegression{7, 956}}) {
-        const SweepCase c = generate_sweep_case(r.seed, r.index, config);
-        const SweepCaseResult result = evaluate_sweep_case(c, config);
-        INFO(c.id << ": " << c.description << ": " << result.problem);
-        CHECK(result.problem.empty());
-    }
+    check_sweep_regressions({{2, 52}, {7, 655}}, {.penetration = true, .every_limit = true});
+    check_sweep_regressions({{1, 62}, {1, 91}, {1, 265}, {2, 227}, {7, 220}, {7, 495}, {7, 512}, {7, 564}, {7, 680},
+                             {7, 684}, {7, 797}, {7, 918}, {7, 950}, {7, 956}},
+                            {.every_limit = true});
 }
 
 // Known failure, kept so it stays found (docs/gait.md, "Branch gait4"): 1-0039
 // (1,529 °/s, shin_l, a 29 cm curb, circles and a step turn). Not fixed yet,
 // so it may fail.
 TEST_CASE("gait sweep known failure: 1-0039, a shin over the limit at a curb", "[gait_sweep][!mayfail]") {
-    const SimConfig& config = shipped_config();
-    const SweepCase c = generate_sweep_case(1, 39, config);
-    const SweepCaseResult result = evaluate_sweep_case(c, config);
-    INFO(c.id << ": " << c.description << ": " << result.problem);
-    CHECK(result.problem.empty());
+    check_sweep_regressions({{1, 39}}, {.every_limit = true});
 }
 
 // 7-0285 (19 cm / 33 cm stairs, walking down; 1,415 °/s on main) reached
@@ -435,11 +404,7 @@ TEST_CASE("gait sweep known failure: 1-0039, a shin over the limit at a curb", "
 // gait3's change 3, dropped on branch gait4): the left foot stepped three
 // treads down, the right was left on the landing above and its thigh flipped.
 TEST_CASE("gait sweep regressions: 7-0285, no thigh flips walking down a flight", "[gait_sweep]") {
-    const SimConfig& config = shipped_config();
-    const SweepCase c = generate_sweep_case(7, 285, config);
-    const SweepCaseResult result = evaluate_sweep_case(c, config);
-    INFO(c.id << ": " << c.description << ": " << result.problem);
-    CHECK(result.problem.empty());
+    check_sweep_regressions({{7, 285}}, {.every_limit = true});
 }
 
 // A swing's clearance floor counts its toe tip swung out sideways, as it counts
@@ -448,15 +413,8 @@ TEST_CASE("gait sweep regressions: 7-0285, no thigh flips walking down a flight"
 // main 545ca01 (mm): 13-0408 145, 13-0002 148, 5-0356 132, 14-0073 36,
 // 13-0116 14, 11-0484 10.6 (six of the 6,000 cases of seeds 3–6 and 8–15).
 TEST_CASE("gait sweep regressions: no toe swings into a riser beside it", "[gait_sweep]") {
-    const SimConfig& config = shipped_config();
-    for (const SweepRegression r : {SweepRegression{13, 408}, SweepRegression{13, 2}, SweepRegression{5, 356},
-                                    SweepRegression{14, 73}, SweepRegression{13, 116}, SweepRegression{11, 484}}) {
-        const SweepCase c = generate_sweep_case(r.seed, r.index, config);
-        INFO(c.id << ": " << c.description);
-        const GaitMetrics m = evaluate_sweep_case(c, config).metrics;
-        CHECK(m.penetration_mm < kMaxPenetrationMm);
-        CHECK(m.foot_skate_mm < kMaxFootSkateMm);
-    }
+    check_sweep_regressions({{13, 408}, {13, 2}, {5, 356}, {14, 73}, {13, 116}, {11, 484}},
+                            {.skate = true, .penetration = true});
 }
 
 // The stand-off holds for every way the root moves (steered, pulled by the
@@ -465,15 +423,8 @@ TEST_CASE("gait sweep regressions: no toe swings into a riser beside it", "[gait
 // beside a 2.16 m wall the idle root settled 5 cm from its face and the right
 // forearm went 82 mm into it (3-0001); 13-0001 12.4 mm, 14-0131 10.0 mm.
 TEST_CASE("gait sweep regressions: the body and feet stay out of walls beside the path", "[gait_sweep]") {
-    const SimConfig& config = shipped_config();
-    for (const SweepRegression r : {SweepRegression{3, 1}, SweepRegression{13, 1}, SweepRegression{14, 131}}) {
-        const SweepCase c = generate_sweep_case(r.seed, r.index, config);
-        INFO(c.id << ": " << c.description);
-        const GaitMetrics m = evaluate_sweep_case(c, config).metrics;
-        CHECK(m.obstacle_penetration_mm < kMaxObstaclePenetrationMm);
-        CHECK(m.penetration_mm < kMaxPenetrationMm);
-        CHECK(m.foot_skate_mm < kMaxFootSkateMm);
-    }
+    check_sweep_regressions({{3, 1}, {13, 1}, {14, 131}},
+                            {.skate = true, .penetration = true, .obstacle = true});
 }
 
 // A step rises or drops at most 0.52 of the leg (0.45 m) from the planted
@@ -483,15 +434,8 @@ TEST_CASE("gait sweep regressions: the body and feet stay out of walls beside th
 // 13-0274 2,140 (stairs), 5-0185 2,060 (curbs) — 27 of the 6,000 cases of
 // seeds 3–6 and 8–15 fixed, 3 broken (1,528–1,704 °/s).
 TEST_CASE("gait sweep regressions: no stride of three or four risers, no folded leg", "[gait_sweep]") {
-    const SimConfig& config = shipped_config();
-    for (const SweepRegression r : {SweepRegression{4, 125}, SweepRegression{11, 479}, SweepRegression{3, 183},
-                                    SweepRegression{10, 487}, SweepRegression{9, 131}, SweepRegression{4, 289},
-                                    SweepRegression{13, 274}, SweepRegression{5, 185}}) {
-        const SweepCase c = generate_sweep_case(r.seed, r.index, config);
-        const SweepCaseResult result = evaluate_sweep_case(c, config);
-        INFO(c.id << ": " << c.description << ": " << result.problem);
-        CHECK(result.problem.empty());
-    }
+    check_sweep_regressions({{4, 125}, {11, 479}, {3, 183}, {10, 487}, {9, 131}, {4, 289}, {13, 274}, {5, 185}},
+                            {.every_limit = true});
 }
 
 // A swinging foot left more than 0.6 m behind its hip lowers the pelvis no
@@ -501,13 +445,6 @@ TEST_CASE("gait sweep regressions: no stride of three or four risers, no folded 
 // 21° ramp, 7,999 °/s). Both are still over the limit (1,673 and 1,535 °/s:
 // the stranded swing itself), so this holds them to the flip's absence.
 TEST_CASE("gait sweep regressions: a swing left far behind does not fold the planted leg", "[gait_sweep]") {
-    const SimConfig& config = shipped_config();
-    for (const SweepRegression r : {SweepRegression{10, 441}, SweepRegression{13, 316}}) {
-        const SweepCase c = generate_sweep_case(r.seed, r.index, config);
-        INFO(c.id << ": " << c.description);
-        const GaitMetrics m = evaluate_sweep_case(c, config).metrics;
-        CHECK(m.max_joint_speed_deg_s < 1800.0);
-        CHECK(m.penetration_mm < kMaxPenetrationMm);
-        CHECK(m.foot_skate_mm < kMaxFootSkateMm);
-    }
+    check_sweep_regressions({{10, 441}, {13, 316}},
+                            {.skate = true, .penetration = true, .joint_speed_deg_s = 1800.0});
 }
