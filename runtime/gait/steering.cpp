@@ -44,22 +44,31 @@ Nearest nearest_on_box(const TerrainBox& b, float x, float z) {
 // distance: what braking can still stop in.
 float approach_limit(float gap, float brake) { return gap > 0.0f ? std::sqrt(2.0f * brake * gap) : 0.0f; }
 
-// Removes from (vx, vz) what approaches any wall faster than it can stop; true when anything was removed.
-bool clip_against_walls(float& vx, float& vz, const NearbyWalls& walls, float x, float z, float brake) {
+// Removes from (vx, vz) the part toward each wall, seen from (x, z), beyond
+// allowed(distance to the wall); true when anything was removed. Twice over
+// the walls, for inside corners.
+template <class Allowed>
+bool clip_toward_walls(float& vx, float& vz, const NearbyWalls& walls, float x, float z, Allowed allowed) {
     bool clipped = false;
-    for (int pass = 0; pass < 2; ++pass)  // twice, for inside corners
+    for (int pass = 0; pass < 2; ++pass)
         for (int i = 0; i < walls.count; ++i) {
             const Nearest n = nearest_on_box(walls.boxes[static_cast<std::size_t>(i)], x, z);
             if (n.distance <= 0.0f) continue;
-            const float allowed = approach_limit(n.distance - kWallStandOffM, brake);
+            const float most = allowed(n.distance);
             const float toward = -(vx * n.nx + vz * n.nz);
-            if (toward > allowed) {
-                vx += n.nx * (toward - allowed);
-                vz += n.nz * (toward - allowed);
+            if (toward > most) {
+                vx += n.nx * (toward - most);
+                vz += n.nz * (toward - most);
                 clipped = true;
             }
         }
     return clipped;
+}
+
+// Removes from (vx, vz) what approaches any wall faster than it can stop; true when anything was removed.
+bool clip_against_walls(float& vx, float& vz, const NearbyWalls& walls, float x, float z, float brake) {
+    return clip_toward_walls(vx, vz, walls, x, z,
+                             [brake](float distance) { return approach_limit(distance - kWallStandOffM, brake); });
 }
 
 // The speed along `forward` that approaches no wall faster than it can stop.
@@ -98,17 +107,8 @@ float turn_speed_cap(double abs_diff, float goal_speed, const GaitConfig& c) {
 
 void keep_root_out_of_walls(const NearbyWalls& walls, float from_x, float from_z, float& x, float& z) {
     float dx = x - from_x, dz = z - from_z;
-    for (int pass = 0; pass < 2; ++pass)  // twice, for inside corners
-        for (int i = 0; i < walls.count; ++i) {
-            const Nearest n = nearest_on_box(walls.boxes[static_cast<std::size_t>(i)], from_x, from_z);
-            if (n.distance <= 0.0f) continue;
-            const float allowed = n.distance > kWallStandOffM ? n.distance - kWallStandOffM : 0.0f;
-            const float toward = -(dx * n.nx + dz * n.nz);
-            if (toward > allowed) {
-                dx += n.nx * (toward - allowed);
-                dz += n.nz * (toward - allowed);
-            }
-        }
+    clip_toward_walls(dx, dz, walls, from_x, from_z,
+                      [](float distance) { return distance > kWallStandOffM ? distance - kWallStandOffM : 0.0f; });
     x = from_x + dx;
     z = from_z + dz;
 }
