@@ -654,6 +654,14 @@ constexpr float kShortestSwing = 0.12f;           // s: a late lift-off still sw
 constexpr float kMaxMeanSwingSpeed = 4.0f;        // m/s: … and at least its travel over this
 constexpr float kWristDrag = 0.4f;                // hand tilt against its path's velocity, per m/cycle
 constexpr float kMaxPelvisVerticalSpeed = 0.9f;   // m/s the pelvis follows its height target at, at most
+// m/s the pelvis sinks at, at most, to meet a landing swing's soft limit: the
+// limit moves with where the hip will be at touchdown, and a run's other foot
+// lifting moved that 4 cm in one tick, 0.95 of the way through the swing; the
+// pelvis fell 5 cm in that tick and both shins spun (2,685 °/s, sweep case
+// 5-0439). Whatever is left at touchdown, the planted reach takes over.
+constexpr float kMaxPelvisSinkSpeed = 3.0f;
+constexpr float kSwingFoldShare = 0.3f;           // of the leg: how far a swinging ankle stays below its hip
+constexpr float kSwingFoldRiseSpeed = 1.5f;       // m/s the pelvis may rise at to keep it there
 
 // Standing spot for a foot beside the other (planted) foot.
 Placement stop_target(const GaitState& g, int foot, float heading, const GaitRig& rig, const Terrain& terrain,
@@ -1245,8 +1253,9 @@ PelvisLimits pelvis_limits(const GaitState& g, const GaitTick& t, vec3 pelvis) {
 }
 
 // The pelvis: its unlimited place, lowered to the soft limit at no more than
-// kMaxPelvisVerticalSpeed, or faster where a swing needs it to meet the soft
-// limit by kSinkByProgress of its swing (evenly over the time left: held to
+// kMaxPelvisVerticalSpeed, or faster (up to kMaxPelvisSinkSpeed) where a swing
+// needs it to meet the soft limit by kSinkByProgress of its swing (evenly over
+// the time left: held to
 // 0.9 m/s, the pelvis arrived late and the hard limit dropped it by up to 3 cm
 // a tick just before touchdown, spinning the shin: hillside × circle
 // 2865 °/s), and never above the hard limit.
@@ -1255,15 +1264,28 @@ void place_pelvis(GaitState& g, const GaitTick& t, vec3 root, float breath_time)
     const PelvisLimits limit = pelvis_limits(g, t, pelvis);
     const float previous_y = g.pelvis.y;
     const float max_move = kMaxPelvisVerticalSpeed * t.dt;
-    const float max_sink = maxf(kMaxPelvisVerticalSpeed, limit.descent) * t.dt;
+    const float max_sink = maxf(kMaxPelvisVerticalSpeed, minf(kMaxPelvisSinkSpeed, limit.descent)) * t.dt;
     pelvis.y = minf(pelvis.y, limit.soft);
     pelvis.y = clampf(pelvis.y, previous_y - max_sink, previous_y + max_move);
+    // A swinging ankle stays kSwingFoldShare of the leg below its hip: a swing
+    // climbing two risers (0.46 m) while a planted foot far below still held
+    // the pelvis down passed 7 cm from its hip and the thigh flipped (3,314 °/s,
+    // sweep case 3-0256). The pelvis rises for it at up to kSwingFoldRiseSpeed,
+    // under the far-swing and planted limits below, which keep their reach.
+    float swing_floor = -kNoLimitM;
+    for (const FootState& f : g.feet)
+        if (f.swinging) swing_floor = maxf(swing_floor, f.ankle.y + kSwingFoldShare * (t.rig.thigh + t.rig.shin));
+    pelvis.y = maxf(pelvis.y, minf(swing_floor, previous_y + kSwingFoldRiseSpeed * t.dt));
     // A swinging foot left far behind (a swing stranded at its lift-off spot
     // a metre back and below while the root runs on across a hillside) pulled
     // the pelvis down to the planted ankle, and that leg's thigh flipped at
     // 8,600 °/s (10-0441, 13-0316): its reach lowers the pelvis no further than
-    // kStanceFloorShare of the leg above a planted ankle; its own leg stretches.
-    pelvis.y = maxf(minf(pelvis.y, limit.far_swing), minf(pelvis.y, limit.floor));
+    // kStanceFloorShare of the leg above a planted ankle, and no faster than the
+    // pelvis may sink (in a run's flight no ankle is planted: a swing re-aimed
+    // behind the hip dropped it 0.2 m in 8 ticks and the other thigh flipped,
+    // 3,593 °/s, sweep case 6-0372); its own leg stretches.
+    const float far_swing_floor = maxf(limit.floor, previous_y - max_sink);
+    pelvis.y = maxf(minf(pelvis.y, limit.far_swing), minf(pelvis.y, far_swing_floor));
     pelvis.y = minf(pelvis.y, limit.hard);
     g.pelvis = pelvis;
 }

@@ -448,3 +448,19 @@ TEST_CASE("gait sweep regressions: a swing left far behind does not fold the pla
     check_sweep_regressions({{10, 441}, {13, 316}},
                             {.skate = true, .penetration = true, .joint_speed_deg_s = 1800.0});
 }
+
+// The pelvis follows a swing within bounds (gait11): a far swing lowers it no
+// faster than it may sink (in a run's flight no ankle was planted to stop it:
+// 6-0372, 3,593 °/s); it sinks toward a landing swing's soft limit at no more
+// than 3 m/s (that limit jumped 4 cm in a tick when the other foot lifted:
+// 5-0439, 2,685 °/s); it rises at up to 1.5 m/s to keep a swinging ankle 0.3 of
+// the leg below its hip (a swing two risers up passed 7 cm from its hip: 3-0256,
+// 3,314 °/s, now 1,989: held to the fold's absence). 17 of the 6,000 cases of
+// seeds 3–6 and 8–15 fixed (main 8554f56 → gait11), 2 broken (1,518 and
+// 1,568 °/s).
+TEST_CASE("gait sweep regressions: the pelvis sinks and rises within bounds for a swing", "[gait_sweep]") {
+    check_sweep_regressions({{6, 372}, {5, 439}, {10, 182}, {10, 342}, {11, 147}, {12, 105}, {12, 199}, {12, 329}, {13, 101},
+                             {14, 129}, {14, 311}, {14, 425}, {4, 385}, {4, 411}, {5, 68}, {8, 256}, {9, 115}},
+                            {.every_limit = true});
+    check_sweep_regressions({{3, 256}}, {.skate = true, .penetration = true, .joint_speed_deg_s = 2100.0});
+}
