@@ -11,6 +11,7 @@
 #include "app/graph/graph_files.hpp"
 #include "runtime/gait/gait.hpp"
 #include "runtime/gait/puppet.hpp"
+#include "runtime/gait/steering.hpp"
 #include "runtime/ground/obstacles.hpp"
 #include "runtime/sim/simulation.hpp"
 
@@ -477,15 +478,19 @@ private:
                 expected_[h] += puppet_.graph_full_speed_m_s * std::sqrt(sx * sx + sy * sy);
             } else {
                 // The command on this ground (ground_speed: slope factor and the
-                // climb cap, docs/gait.md), followed at the configured acceleration
-                // as the gait follows it: on stairs and changing slopes the command
+                // climb cap, docs/gait.md) where the tick began — the gait reads
+                // it there, before it moves — followed as the steering law follows
+                // it (steer_root): up at the configured acceleration, down at the
+                // braking deceleration. On stairs and changing slopes the command
                 // changes under the puppet, and a speed cannot jump.
                 const float deflection = std::min(1.0f, std::sqrt(hold.stick_x * hold.stick_x + hold.stick_y * hold.stick_y));
-                const double command = ground_speed(terrain_, config_, stick_speed_fraction(deflection, config_), pelvis.x,
-                                                    pelvis.z, s.heading);
-                const double max_change = config_.acceleration / config_.tick_rate_hz;
+                const vec3 before = previous_.model_positions[puppet_.pelvis_joint];
+                const double command = ground_speed(terrain_, config_, stick_speed_fraction(deflection, config_), before.x,
+                                                    before.z, previous_.heading);
+                const double max_up = config_.acceleration / config_.tick_rate_hz;
+                const double max_down = brake_deceleration(config_) / config_.tick_rate_hz;
                 if (k == hold.first_tick) following_[h] = command;
-                else following_[h] += std::clamp(command - following_[h], -max_change, max_change);
+                else following_[h] += std::clamp(command - following_[h], -max_down, max_up);
                 expected_[h] += following_[h];
             }
             if (k == hold.first_tick) last_sample_[h] = pelvis;
