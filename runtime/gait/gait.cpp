@@ -495,6 +495,9 @@ void begin_swing(FootState& f, const Placement& target, const Terrain& terrain, 
     const float distance = horizontal_distance(f.start, f.target);
     f.lift_scale = clampf(distance / 0.3f, 0.35f, 1.0f);
     f.swinging = 1;
+    f.reaim_velocity = vec3(0.0f);
+    f.reaim_time = 0.0f;
+    f.reaim_span = 0.0f;
     build_swing_path(f, terrain, rig, c, blend);
 }
 
@@ -525,11 +528,19 @@ SwingPoint swing_point(const FootState& f, int foot, const GaitRig& rig, float b
     return {p, reach};
 }
 
+// The carried re-aim velocity's displacement after t of span T: v·t·(1 − t/T)²,
+// which starts at the velocity v and ends at rest, back on the new path, at T.
+vec3 reaim_offset(const FootState& f) {
+    if (f.reaim_span <= 0.0f || f.reaim_time >= f.reaim_span) return vec3(0.0f);
+    const float rest = 1.0f - f.reaim_time / f.reaim_span;
+    return f.reaim_velocity * (f.reaim_time * rest * rest);
+}
+
 void evaluate_swing(FootState& f, int foot, const GaitConfig& c, const GaitRig& rig, float blend, vec3 left) {
     (void)c;
     const SwingPoint at = swing_point(f, foot, rig, blend, left, f.progress);
     f.fraction = at.reach;
-    f.ankle = at.ankle;
+    f.ankle = at.ankle + reaim_offset(f);
     f.rotation = swing_rotation(f, at.reach);
     f.ground = f.start_ground + (f.target_ground - f.start_ground) * at.reach;
 }
@@ -542,6 +553,9 @@ void land(FootState& f, GaitState& g) {
     f.progress = 0.0f;
     f.timed_rate = 0.0f;
     f.replanned = 0;
+    f.reaim_velocity = vec3(0.0f);
+    f.reaim_time = 0.0f;
+    f.reaim_span = 0.0f;
     ++g.steps;
 }
 
@@ -791,6 +805,9 @@ constexpr float kMinSwingPhaseShare = 1e-3f;       // least (1 − lift phase) a
 constexpr float kReaimSpeedChange = 0.25f;         // m/s: a commanded speed change this large re-aims a swing
 constexpr double kReaimHeadingChangeRad = 0.25;    // rad: a stick direction change this large re-aims a swing
 constexpr float kLatestReaimProgress = 0.6f;       // a swing further along keeps its target
+constexpr float kReaimCarryS = 0.1f;              // s: a re-aim's carried velocity dies out over at most this
+constexpr float kReaimCarryShare = 0.5f;          // … and at most this share of the new swing's time
+constexpr float kMaxReaimCarrySpeed = 6.0f;       // m/s: the most velocity a re-aim carries
 constexpr float kStanceReachM = 0.42f;             // m: the root keeps each planted foot this close to its hip, horizontally
 constexpr std::int32_t kMaxReaims = 3;             // a swing re-aims at most this often (the stick turning on)
 constexpr float kMinReaimShiftM = 0.06f;           // m: a new target closer than this to the old one is not taken
@@ -1062,9 +1079,25 @@ void reaim_if_command_changed(GaitState& g, const GaitTick& t, vec3 root, int i)
     const bool closer = !stranded || horizontal_distance(aimed.ankle, hip_then) < gap - kMinReaimShiftM;
     if (closer && horizontal_distance(aimed.ankle, f.target) > kMinReaimShiftM) {
         const float ground = f.ground;
+        // Where the old swing puts the foot this tick: the velocity it moved at.
+        const vec3 old_now = swing_point(f, i, t.rig, g.run_blend, t.h.left, f.progress).ankle + reaim_offset(f);
+        const vec3 from = f.ankle;
         begin_aimed_swing(g, t, i, psi, stranded ? aimed : aimed_target(g, t, root, i, psi));
         f.start_ground = ground;
         ++f.replanned;
+        // The new path starts from rest (it lifts straight up, its progress eases
+        // in), so the foot stopped dead in one tick and the shin spun (sweep cases
+        // 12-0383 and 14-0468 at 1,686 and 4,254 °/s, 7-0456 at 3,800 °/s). The
+        // velocity the old swing moved at is carried instead and dies out over
+        // the span: sideways, forward and up, never down (carried down, it took
+        // the sole into the ground; docs/gait.md, gait12).
+        vec3 v = (old_now - from) / t.dt;
+        if (v.y < 0.0f) v.y = 0.0f;
+        const float speed = std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+        if (speed > kMaxReaimCarrySpeed) v *= kMaxReaimCarrySpeed / speed;
+        f.reaim_velocity = v;
+        f.reaim_time = t.dt;
+        f.reaim_span = minf(kReaimCarryS, kReaimCarryShare / swing_rate(f, t));
     }
     f.planned_speed = g.commanded_speed;
     f.planned_heading = t.desired_heading;
@@ -1083,6 +1116,14 @@ void advance_swing(GaitState& g, const GaitTick& t, vec3 root, int i) {
         land(f, g);
         g.first_step = 0;
         return;
+    }
+    if (f.reaim_span > 0.0f) {
+        f.reaim_time += t.dt;
+        if (f.reaim_time >= f.reaim_span) {
+            f.reaim_velocity = vec3(0.0f);
+            f.reaim_time = 0.0f;
+            f.reaim_span = 0.0f;
+        }
     }
     reaim_if_command_changed(g, t, root, i);
     evaluate_swing(f, i, t.c, t.rig, g.run_blend, t.h.left);

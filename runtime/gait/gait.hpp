@@ -44,6 +44,13 @@ struct FootState {
     std::int32_t replanned = 0;               // times this swing re-aimed (at most 3)
     float planned_speed = 0.0f;               // the command the target was planned for
     float planned_heading = 0.0f;
+    // A re-aimed swing carries the foot's horizontal velocity from before the
+    // re-aim into the new path and lets it die out over reaim_span seconds, so
+    // the foot does not stop dead in one tick (docs/gait.md, gait12). Zero
+    // (reaim_span 0) when no re-aim is being carried.
+    vec3 reaim_velocity{0.0f};
+    float reaim_time = 0.0f;                  // s since the re-aim
+    float reaim_span = 0.0f;                  // s over which the carried velocity dies out
     // The swing path: ankle height at evenly spaced fractions of the step, clear
     // of the ground under the sole (steps up, box edges), and its arc-length
     // table (the foot's progress along it is by length: docs/gait.md).

@@ -82,6 +82,13 @@ void hash_gait(HashBytes& h, const GaitState& g) {
         hash_floats(h, f.path_height.data(), f.path_height.size());
         hash_floats(h, f.path_length.length.data(), f.path_length.length.size());
         hash_ints(h, {f.swinging, f.replanned});
+        // Only while a re-aim's velocity is carried: the states without one hash
+        // as they did before the fields existed.
+        if (f.reaim_span > 0.0f) {
+            hash_vec(h, f.reaim_velocity);
+            const float carry[2] = {f.reaim_time, f.reaim_span};
+            hash_floats(h, carry, 2);
+        }
         const float plan[2] = {f.planned_speed, f.planned_heading};
         hash_floats(h, plan, 2);
     }
