@@ -658,9 +658,14 @@ Placement plan_target(const GaitState& g, const GaitTick& t, int foot, vec3 root
     const Placement placed = keep_off_obstacles(t.terrain, t.rig, place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, forward),
                                                 spot, hip_now, forward, t.c.max_step_height);
     const FootState& other = g.feet[static_cast<std::size_t>(1 - foot)];
-    if (other.swinging) return placed;
-    const vec3 beside = other.ankle + then.left * (side_sign(foot) * 2.0f * t.rig.hip_half_width);
-    return keep_within_rise(t.terrain, t.rig, placed, spot, beside, forward, other.ground,
+    // In a run's flight the other foot is not planted yet: its landing is what
+    // this step rises or drops from. Unlimited there, one foot re-aimed four
+    // risers above the other while the other re-aimed down, and the higher leg
+    // folded past its hip (sweep case 10-0487, 2,206 °/s; gait13).
+    const vec3 other_at = other.swinging ? other.target : other.ankle;
+    const float other_ground = other.swinging ? other.target_ground : other.ground;
+    const vec3 beside = other_at + then.left * (side_sign(foot) * 2.0f * t.rig.hip_half_width);
+    return keep_within_rise(t.terrain, t.rig, placed, spot, beside, forward, other_ground,
                             kMaxStrideRiseShare * (t.rig.thigh + t.rig.shin), t.c.max_step_height);
 }
 
