@@ -496,6 +496,7 @@ void begin_swing(FootState& f, const Placement& target, const Terrain& terrain, 
     f.lift_scale = clampf(distance / 0.3f, 0.35f, 1.0f);
     f.swinging = 1;
     f.reaim_velocity = vec3(0.0f);
+    f.reaim_spin = vec3(0.0f);
     f.reaim_time = 0.0f;
     f.reaim_span = 0.0f;
     build_swing_path(f, terrain, rig, c, blend);
@@ -539,6 +540,7 @@ vec3 reaim_offset(const FootState& f) {
 constexpr float kReaimCarryS = 0.1f;              // s: a re-aim's carried velocity dies out over at most this
 constexpr float kReaimCarryShare = 0.5f;          // … and at most this share of the new swing's time
 constexpr float kMaxReaimCarrySpeed = 6.0f;       // m/s: the most velocity a re-aim carries
+constexpr float kMaxReaimCarrySpin = 10.0f;       // rad/s: the most turn rate it carries
 
 // A swing just restarted toward a new target (begin_swing: from rest) takes
 // over the velocity the old one moved the foot at, from `from` (last tick) to
@@ -547,6 +549,30 @@ constexpr float kMaxReaimCarrySpeed = 6.0f;       // m/s: the most velocity a re
 // new swing's `swing_time`; `elapsed` of it has passed by the swing's next
 // evaluation. (Tried for a stop's quick swing too: 79 → 80 failing of the
 // 6,000 sweep cases, one sole into the ground; not kept.)
+// The carried spin's turn after t of span T: |w|·t·(1 − t/T)² about w.
+quat reaim_turn(const FootState& f) {
+    if (f.reaim_span <= 0.0f || f.reaim_time >= f.reaim_span) return quat_identity();
+    const float rate = std::sqrt(dot3(f.reaim_spin, f.reaim_spin));
+    if (rate <= 1e-6f) return quat_identity();
+    const float rest = 1.0f - f.reaim_time / f.reaim_span;
+    return quat_axis_angle(f.reaim_spin / rate, static_cast<double>(rate * (f.reaim_time * rest * rest)));
+}
+
+// The same for the foot's turn: the new swing holds its start rotation for a
+// while (kHoldRotationShare), so a foot turning toward the old target stopped
+// turning in one tick and the foot joint spun (gait14). Its rate from `from`
+// (last tick) to `old_now` is carried, at most kMaxReaimCarrySpin.
+void carry_swing_spin(FootState& f, quat old_now, quat from, float dt) {
+    f.reaim_spin = vec3(0.0f);
+    quat d = quat_mul(old_now, quat_conjugate(from));
+    if (d.w < 0.0f) d = quat(-d.w, -d.x, -d.y, -d.z);
+    const float s = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    if (s <= 1e-7f) return;
+    const float angle = static_cast<float>(2.0 * det::atan2(s, d.w));
+    const float rate = minf(angle / dt, kMaxReaimCarrySpin);
+    f.reaim_spin = vec3(d.x, d.y, d.z) * (rate / s);
+}
+
 void carry_swing_velocity(FootState& f, vec3 old_now, vec3 from, float dt, float swing_time, float elapsed) {
     vec3 v = (old_now - from) / dt;
     if (v.y < 0.0f) v.y = 0.0f;
@@ -563,6 +589,7 @@ void evaluate_swing(FootState& f, int foot, const GaitConfig& c, const GaitRig& 
     f.fraction = at.reach;
     f.ankle = at.ankle + reaim_offset(f);
     f.rotation = swing_rotation(f, at.reach);
+    if (f.reaim_span > 0.0f && dot3(f.reaim_spin, f.reaim_spin) > 0.0f) f.rotation = quat_normalize(quat_mul(reaim_turn(f), f.rotation));
     f.ground = f.start_ground + (f.target_ground - f.start_ground) * at.reach;
 }
 
@@ -575,6 +602,7 @@ void land(FootState& f, GaitState& g) {
     f.timed_rate = 0.0f;
     f.replanned = 0;
     f.reaim_velocity = vec3(0.0f);
+    f.reaim_spin = vec3(0.0f);
     f.reaim_time = 0.0f;
     f.reaim_span = 0.0f;
     ++g.steps;
@@ -1103,7 +1131,10 @@ void reaim_if_command_changed(GaitState& g, const GaitTick& t, vec3 root, int i)
     if (closer && horizontal_distance(aimed.ankle, f.target) > kMinReaimShiftM) {
         const float ground = f.ground;
         // Where the old swing puts the foot this tick: the velocity it moved at.
-        const vec3 old_now = swing_point(f, i, t.rig, g.run_blend, t.h.left, f.progress).ankle + reaim_offset(f);
+        const SwingPoint old_at = swing_point(f, i, t.rig, g.run_blend, t.h.left, f.progress);
+        const vec3 old_now = old_at.ankle + reaim_offset(f);
+        const quat old_rotation = quat_mul(reaim_turn(f), swing_rotation(f, old_at.reach));
+        const quat from_rotation = f.rotation;
         const vec3 from = f.ankle;
         begin_aimed_swing(g, t, i, psi, stranded ? aimed : aimed_target(g, t, root, i, psi));
         f.start_ground = ground;
@@ -1115,6 +1146,7 @@ void reaim_if_command_changed(GaitState& g, const GaitTick& t, vec3 root, int i)
         // the span: sideways, forward and up, never down (carried down, it took
         // the sole into the ground; docs/gait.md, gait12).
         carry_swing_velocity(f, old_now, from, t.dt, 1.0f / swing_rate(f, t), t.dt);
+        carry_swing_spin(f, old_rotation, from_rotation, t.dt);
     }
     f.planned_speed = g.commanded_speed;
     f.planned_heading = t.desired_heading;
@@ -1138,6 +1170,7 @@ void advance_swing(GaitState& g, const GaitTick& t, vec3 root, int i) {
         f.reaim_time += t.dt;
         if (f.reaim_time >= f.reaim_span) {
             f.reaim_velocity = vec3(0.0f);
+            f.reaim_spin = vec3(0.0f);
             f.reaim_time = 0.0f;
             f.reaim_span = 0.0f;
         }

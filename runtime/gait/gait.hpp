@@ -49,6 +49,7 @@ struct FootState {
     // the foot does not stop dead in one tick (docs/gait.md, gait12). Zero
     // (reaim_span 0) when no re-aim is being carried.
     vec3 reaim_velocity{0.0f};
+    vec3 reaim_spin{0.0f};                    // rad/s about the axis it points along, likewise
     float reaim_time = 0.0f;                  // s since the re-aim
     float reaim_span = 0.0f;                  // s over which the carried velocity dies out
     // The swing path: ankle height at evenly spaced fractions of the step, clear

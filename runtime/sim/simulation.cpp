@@ -86,6 +86,7 @@ void hash_gait(HashBytes& h, const GaitState& g) {
         // as they did before the fields existed.
         if (f.reaim_span > 0.0f) {
             hash_vec(h, f.reaim_velocity);
+            hash_vec(h, f.reaim_spin);
             const float carry[2] = {f.reaim_time, f.reaim_span};
             hash_floats(h, carry, 2);
         }
