@@ -542,13 +542,6 @@ constexpr float kReaimCarryShare = 0.5f;          // … and at most this share 
 constexpr float kMaxReaimCarrySpeed = 6.0f;       // m/s: the most velocity a re-aim carries
 constexpr float kMaxReaimCarrySpin = 10.0f;       // rad/s: the most turn rate it carries
 
-// A swing just restarted toward a new target (begin_swing: from rest) takes
-// over the velocity the old one moved the foot at, from `from` (last tick) to
-// `old_now` (where the old swing puts it this tick): sideways, forward and up,
-// never down, dying out over at most kReaimCarryS and kReaimCarryShare of the
-// new swing's `swing_time`; `elapsed` of it has passed by the swing's next
-// evaluation. (Tried for a stop's quick swing too: 79 → 80 failing of the
-// 6,000 sweep cases, one sole into the ground; not kept.)
 // The carried spin's turn after t of span T: |w|·t·(1 − t/T)² about w.
 quat reaim_turn(const FootState& f) {
     if (f.reaim_span <= 0.0f || f.reaim_time >= f.reaim_span) return quat_identity();
@@ -573,6 +566,13 @@ void carry_swing_spin(FootState& f, quat old_now, quat from, float dt) {
     f.reaim_spin = vec3(d.x, d.y, d.z) * (rate / s);
 }
 
+// A swing just restarted toward a new target (begin_swing: from rest) takes
+// over the velocity the old one moved the foot at, from `from` (last tick) to
+// `old_now` (where the old swing puts it this tick): sideways, forward and up,
+// never down, dying out over at most kReaimCarryS and kReaimCarryShare of the
+// new swing's `swing_time`; `elapsed` of it has passed by the swing's next
+// evaluation. (Tried for a stop's quick swing too: 79 → 80 failing of the
+// 6,000 sweep cases, one sole into the ground; not kept.)
 void carry_swing_velocity(FootState& f, vec3 old_now, vec3 from, float dt, float swing_time, float elapsed) {
     vec3 v = (old_now - from) / dt;
     if (v.y < 0.0f) v.y = 0.0f;
@@ -589,7 +589,8 @@ void evaluate_swing(FootState& f, int foot, const GaitConfig& c, const GaitRig& 
     f.fraction = at.reach;
     f.ankle = at.ankle + reaim_offset(f);
     f.rotation = swing_rotation(f, at.reach);
-    if (f.reaim_span > 0.0f && dot3(f.reaim_spin, f.reaim_spin) > 0.0f) f.rotation = quat_normalize(quat_mul(reaim_turn(f), f.rotation));
+    if (f.reaim_span > 0.0f && dot3(f.reaim_spin, f.reaim_spin) > 0.0f)
+        f.rotation = quat_normalize(quat_mul(reaim_turn(f), f.rotation));
     f.ground = f.start_ground + (f.target_ground - f.start_ground) * at.reach;
 }
 

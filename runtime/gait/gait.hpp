@@ -44,10 +44,11 @@ struct FootState {
     std::int32_t replanned = 0;               // times this swing re-aimed (at most 3)
     float planned_speed = 0.0f;               // the command the target was planned for
     float planned_heading = 0.0f;
-    // A re-aimed swing carries the foot's horizontal velocity from before the
-    // re-aim into the new path and lets it die out over reaim_span seconds, so
-    // the foot does not stop dead in one tick (docs/gait.md, gait12). Zero
-    // (reaim_span 0) when no re-aim is being carried.
+    // A re-aimed swing carries the foot's velocity (sideways, forward and up)
+    // and turn rate from before the re-aim into the new path and lets them die
+    // out over reaim_span seconds, so the foot does not stop dead in one tick
+    // (docs/gait.md, gait12 and gait14). Zero (reaim_span 0) when no re-aim is
+    // being carried.
     vec3 reaim_velocity{0.0f};
     vec3 reaim_spin{0.0f};                    // rad/s about the axis it points along, likewise
     float reaim_time = 0.0f;                  // s since the re-aim

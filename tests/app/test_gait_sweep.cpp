@@ -392,7 +392,6 @@ TEST_CASE("gait sweep regressions: a stranded swing does not re-aim every tick a
                             {.every_limit = true});
 }
 
-
 // 7-0285 (19 cm / 33 cm stairs, walking down; 1,415 °/s on main) reached
 // 18,398 °/s (thigh_r) with the path prediction asking ground_speed() (branch
 // gait3's change 3, dropped on branch gait4): the left foot stepped three

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The CI sweep as a ratchet (issue 13, docs/gait.md "The sweep in CI").
+"""The CI sweep as a ratchet (issue 13; docs/gait.md, the sweep's section).
 
 Runs `gait-eval --sweep` for seeds 1 and 2 (300 cases each) and 7 (1,000, the
 issue's done-when) and compares the failing cases with the known list in
