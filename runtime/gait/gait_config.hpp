@@ -46,7 +46,7 @@ struct GaitConfig {
     float interpolation_rate = 8.0f;       // 1/s: lean, walk/run blend and pelvis height approach their targets
     float slope_speed_factor = 0.01f;      // speed reduction per degree of slope along the heading
     float turn_in_place_deg = 120.0f;      // reversals wider than this turn in place
-    float stop_transition_s = 0.3f;        // the swing foot's time to plant after a stop, at most
+    float stop_transition_s = 0.3f;        // the swing foot's time to plant after a stop, at most (longer only to keep it under 3 m/s)
     float max_step_height = 0.35f;         // m: a box rising more than this above the ground beside it is an obstacle
     float breath_amplitude = 0.005f;       // m of pelvis rise when idle
     float breath_period_s = 4.0f;
