@@ -175,17 +175,30 @@ float duty_for(const GaitConfig& c, float speed) { return running(c, speed) ? c.
 
 float foot_phase(float cycle_phase, int foot) { return frac(cycle_phase - (foot == 0 ? 0.0f : 0.5f)); }
 
-// The foot's rotation at step fraction s. It turns with the path, not with
-// time, so the toes point where the swing path's clearance floor looked for
-// them (build_swing_path); s already eases in and out over the swing (the
-// prototype's progress has zero tangents at both ends), so no further easing.
-// The toes keep their lift-off direction for the first kHoldRotationShare of
-// the step and reach their landing direction kHoldRotationShare before its end,
-// so a foot planted beside a riser lifts before its toes sweep toward it (the
-// path's clearance floor starts at its second key).
+// The foot's rotation at step fraction s, as the swing path's clearance keys
+// see it (build_swing_path). The toes keep their lift-off direction for the
+// first kHoldRotationShare of the step and reach their landing direction
+// kHoldRotationShare before its end, so a foot planted beside a riser lifts
+// before its toes sweep toward it (the path's clearance floor starts at its
+// second key). The foot is posed by posed_swing_rotation: the same holds, the
+// turn between them even in time.
 constexpr float kHoldRotationShare = 0.1f;
 quat swing_rotation(const FootState& f, float s) {
     const float turn = clampf((s - kHoldRotationShare) / (1.0f - 2.0f * kHoldRotationShare), 0.0f, 1.0f);
+    return quat_slerp(f.start_rotation, f.target_rotation, turn);
+}
+
+// The foot's rotation at swing progress u, as it is posed: the same turn
+// spread evenly over time between the progress where the step fraction passes
+// kHoldRotationShare and where it passes 1 - kHoldRotationShare (gait16). By
+// the step fraction (swing_rotation), the turn went at the fraction's speed,
+// 3-4 times its mean mid-swing: an 86° turn in a 0.3 s step spun the foot at
+// 1,230 °/s (sweep case 7-0613). The path's clearance keys still use
+// swing_rotation: both hold the same rotations up to the window's start and
+// from its end, where the foot is near the ground.
+quat posed_swing_rotation(const FootState& f, float u) {
+    const float span = f.turn_to - f.turn_from;
+    const float turn = span > 1e-4f ? clampf((u - f.turn_from) / span, 0.0f, 1.0f) : (u >= f.turn_from ? 1.0f : 0.0f);
     return quat_slerp(f.start_rotation, f.target_rotation, turn);
 }
 
@@ -478,6 +491,8 @@ Placement keep_within_rise(const Terrain& terrain, const GaitRig& rig, const Pla
     return nearest;
 }
 
+void find_turn_window(FootState& f, const GaitRig& rig, float blend);
+
 // Starts (or re-aims) a swing from where the foot is now toward a planted target.
 void begin_swing(FootState& f, const Placement& target, const Terrain& terrain, const GaitRig& rig, const GaitConfig& c,
                  float blend, float lift_phase, float timed_rate) {
@@ -500,6 +515,7 @@ void begin_swing(FootState& f, const Placement& target, const Terrain& terrain, 
     f.reaim_time = 0.0f;
     f.reaim_span = 0.0f;
     build_swing_path(f, terrain, rig, c, blend);
+    find_turn_window(f, rig, blend);
 }
 
 // Where the swing puts the foot at progress u. The blended prototype's z says
@@ -527,6 +543,41 @@ SwingPoint swing_point(const FootState& f, int foot, const GaitRig& rig, float b
     vec3 p = lerp(f.start, f.target, reach) + left * (side_sign(foot) * shape.x * f.lift_scale * out);
     p.y = on_path.y;
     return {p, reach};
+}
+
+// The swing's progress where its step fraction passes `reach` (interior:
+// between the straight lift-off and set-down). The fraction is linear in the
+// path's parameter s there (swing_path_keys: key_reach against key_fraction),
+// the arc-length table gives the share of the path's length covered at s, and
+// the prototype's z says at what progress that share is reached: inverted by
+// bisection, kTurnWindowSteps halvings (it never falls as progress rises).
+// Bisecting swing_point itself, the same window cost 4 % more instructions a
+// walk tick (the arc-length inversion per evaluation).
+constexpr int kTurnWindowSteps = 12;
+float progress_at_reach(const FootState& f, const GaitRig& rig, float blend, float reach) {
+    constexpr int n = kSwingPathKeys;
+    const float grid = static_cast<float>(kKeyGrid[1]) + reach * static_cast<float>(kKeyGrid[n - 2] - kKeyGrid[1]);
+    const int j = static_cast<int>(grid) < kArcLengthIntervals - 1 ? static_cast<int>(grid) : kArcLengthIntervals - 1;
+    const float w = grid - static_cast<float>(j);
+    const std::array<float, kArcLengthIntervals + 1>& length = f.path_length.length;
+    const float covered = length[static_cast<std::size_t>(j)] + (length[static_cast<std::size_t>(j + 1)] - length[static_cast<std::size_t>(j)]) * w;
+    const float total = f.path_length.total();
+    const float share = total > 1e-6f ? covered / total : grid / static_cast<float>(kArcLengthIntervals);
+    float lo = 0.0f, hi = 1.0f;
+    for (int k = 0; k < kTurnWindowSteps; ++k) {
+        const float mid = 0.5f * (lo + hi);
+        if (clampf(blended_swing(rig, blend, mid).z, 0.0f, 1.0f) < share) lo = mid;
+        else hi = mid;
+    }
+    return hi;
+}
+
+// The posed turn's window (posed_swing_rotation), once per swing: the path
+// and its arc-length table are built; the blend may drift a little over the
+// swing, which moves the fraction's 0.1 and 0.9 by as little.
+void find_turn_window(FootState& f, const GaitRig& rig, float blend) {
+    f.turn_from = progress_at_reach(f, rig, blend, kHoldRotationShare);
+    f.turn_to = maxf(f.turn_from, progress_at_reach(f, rig, blend, 1.0f - kHoldRotationShare));
 }
 
 // The carried re-aim velocity's displacement after t of span T: v·t·(1 − t/T)²,
@@ -588,7 +639,7 @@ void evaluate_swing(FootState& f, int foot, const GaitConfig& c, const GaitRig& 
     const SwingPoint at = swing_point(f, foot, rig, blend, left, f.progress);
     f.fraction = at.reach;
     f.ankle = at.ankle + reaim_offset(f);
-    f.rotation = swing_rotation(f, at.reach);
+    f.rotation = posed_swing_rotation(f, f.progress);
     if (f.reaim_span > 0.0f && dot3(f.reaim_spin, f.reaim_spin) > 0.0f)
         f.rotation = quat_normalize(quat_mul(reaim_turn(f), f.rotation));
     f.ground = f.start_ground + (f.target_ground - f.start_ground) * at.reach;
@@ -606,6 +657,8 @@ void land(FootState& f, GaitState& g) {
     f.reaim_spin = vec3(0.0f);
     f.reaim_time = 0.0f;
     f.reaim_span = 0.0f;
+    f.turn_from = 0.0f;
+    f.turn_to = 1.0f;
     ++g.steps;
 }
 
@@ -1138,7 +1191,7 @@ void reaim_if_command_changed(GaitState& g, const GaitTick& t, vec3 root, int i)
         // Where the old swing puts the foot this tick: the velocity it moved at.
         const SwingPoint old_at = swing_point(f, i, t.rig, g.run_blend, t.h.left, f.progress);
         const vec3 old_now = old_at.ankle + reaim_offset(f);
-        const quat old_rotation = quat_mul(reaim_turn(f), swing_rotation(f, old_at.reach));
+        const quat old_rotation = quat_mul(reaim_turn(f), posed_swing_rotation(f, f.progress));
         const quat from_rotation = f.rotation;
         const vec3 from = f.ankle;
         begin_aimed_swing(g, t, i, psi, stranded ? aimed : aimed_target(g, t, root, i, psi));

@@ -53,6 +53,11 @@ struct FootState {
     vec3 reaim_spin{0.0f};                    // rad/s about the axis it points along, likewise
     float reaim_time = 0.0f;                  // s since the re-aim
     float reaim_span = 0.0f;                  // s over which the carried velocity dies out
+    // The swing's progress over which the foot turns from its start rotation to
+    // its target's: from where the step fraction reaches kHoldRotationShare to
+    // where it reaches 1 - kHoldRotationShare (docs/gait.md, gait16).
+    float turn_from = 0.0f;
+    float turn_to = 1.0f;
     // The swing path: ankle height at evenly spaced fractions of the step, clear
     // of the ground under the sole (steps up, box edges), and its arc-length
     // table (the foot's progress along it is by length: docs/gait.md).

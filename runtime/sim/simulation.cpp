@@ -92,6 +92,10 @@ void hash_gait(HashBytes& h, const GaitState& g) {
         }
         const float plan[2] = {f.planned_speed, f.planned_heading};
         hash_floats(h, plan, 2);
+        if (f.swinging) {
+            const float turn[2] = {f.turn_from, f.turn_to};
+            hash_floats(h, turn, 2);
+        }
     }
     hash_vec(h, g.pelvis);
     const float scalars[7] = {g.cycle_phase, g.speed, g.commanded_speed, g.run_blend, g.pelvis_base, g.lean, g.activity};
