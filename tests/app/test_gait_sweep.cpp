@@ -504,9 +504,6 @@ TEST_CASE("gait sweep regressions: a swinging foot turns evenly in time, no foot
                             {.every_limit = true});
 }
 
-// Known failures, kept so they stay found: cases a change fixed once and a
-// later change broke again (docs/gait.md). They may fail; the tests above hold
-// them to bounds they must not pass.
 // A built swing takes its whole path, climbs and drops included, at no more
 // than 5 m/s on average (gait17): held to its horizontal travel at 4 m/s only,
 // a step beside a riser lifted 0.22 m straight up at 9 m/s and the shin spun
@@ -520,6 +517,9 @@ TEST_CASE("gait sweep regressions: a swing takes its climb and drop at a bounded
                             {.every_limit = true});
 }
 
+// Known failures, kept so they stay found: cases a change fixed once and a
+// later change broke again (docs/gait.md). They may fail; the tests above hold
+// them to bounds they must not pass.
 TEST_CASE("gait sweep known failure: 14-0468 (gait13), broken again", "[gait_sweep][!mayfail]") {
     check_sweep_regressions({{14, 468}}, {.every_limit = true});
 }
