@@ -171,7 +171,19 @@ float step_duration(const GaitConfig& c, float speed) {
 }
 
 bool running(const GaitConfig& c, float speed) { return speed > c.run_threshold; }
-float duty_for(const GaitConfig& c, float speed) { return running(c, speed) ? c.run_duty : c.walk_duty; }
+constexpr float kMaxMeanSwingSpeed = 4.0f;  // m/s: a phase-driven swing takes at least its travel over this
+// A walk's swing covers the stride, speed × cycle, in (1 − duty) of the cycle:
+// its mean horizontal speed is speed / (1 − duty), at walk_duty 0.58 over
+// kMaxMeanSwingSpeed above 1.68 m/s. Those swings were held to that speed and
+// landed late, and the planted foot behind held the root (sweep case 7-0551, a
+// 1.89 m/s walk down a 23° ramp, 2.2 % slow). A fast walk's duty shrinks so its
+// swings keep within kWalkSwingSpeedShare of that speed (the rest is margin for
+// the path's climb and curve), never below 0.5: a walk keeps a foot down.
+constexpr float kWalkSwingSpeedShare = 0.9f;
+float duty_for(const GaitConfig& c, float speed) {
+    if (running(c, speed)) return c.run_duty;
+    return maxf(0.5f, minf(c.walk_duty, 1.0f - speed / (kWalkSwingSpeedShare * kMaxMeanSwingSpeed)));
+}
 
 float foot_phase(float cycle_phase, int foot) { return frac(cycle_phase - (foot == 0 ? 0.0f : 0.5f)); }
 
@@ -698,6 +710,7 @@ struct PathPrediction {
     float time = 0.0f;     // s until the swing foot lands
     RootMotion landing;    // the root then
     RootMotion mid_stance; // … and half its coming stance later
+    double turned = 0.0;   // rad the heading turns until then, unwrapped (+ left)
 };
 
 constexpr int kMaxPredictedTicks = 1200;
@@ -724,7 +737,9 @@ PathPrediction predict_path(const GaitState& g, const GaitTick& t, vec3 root, fl
     float target = t.target_speed;
     int k = 0;
     for (; k < kMaxPredictedTicks && phase_left > 0.0f; ++k) {
+        const float before = m.heading;
         if (t.goal.speed > 0.0f) target = steer_root(m, t.goal, t.walls, t.c, t.dt).target_speed;
+        out.turned += det::wrap_angle(static_cast<double>(m.heading) - before);
         phase_left -= t.dt / (2.0f * step_plan(t.c, m.speed, target, m.turning_in_place != 0).duration);
         out.time += t.dt;
     }
@@ -732,7 +747,9 @@ PathPrediction predict_path(const GaitState& g, const GaitTick& t, vec3 root, fl
     const StepPlan next = step_plan(t.c, m.speed, target, m.turning_in_place != 0);
     float stance_left = next.duty * next.duration;  // half of duty · 2 · duration
     for (; k < kMaxPredictedTicks && stance_left > 0.0f; ++k) {
+        const float before = m.heading;
         if (t.goal.speed > 0.0f) steer_root(m, t.goal, t.walls, t.c, t.dt);
+        out.turned += det::wrap_angle(static_cast<double>(m.heading) - before);
         stance_left -= t.dt;
     }
     out.mid_stance = m;
@@ -752,10 +769,16 @@ Placement plan_target(const GaitState& g, const GaitTick& t, int foot, vec3 root
     const vec3 spot = under + then.left * (side_sign(foot) * t.rig.hip_half_width);
     // The foot turns at most kMaxTurnPerStepDeg in one swing, and no faster than
     // kMaxFootTurnDegS on average (a sharp turn takes more steps to face round).
+    // It turns the way the root will (gait19): toward the heading now, then on
+    // by the turn predicted, unwrapped. Aimed at the heading then by the
+    // shortest way, a foot behind a root spinning with a circling stick (the
+    // heading then more than 180° round from the toes) turned against the spin,
+    // and the next re-aim turned it back: sweep case 7-0163, the foot joint at
+    // 1,697 °/s.
     const vec3 toes = quat_rotate(g.feet[static_cast<std::size_t>(foot)].rotation, vec3(0.0f, 0.0f, 1.0f));
     const double yaw = det::atan2(toes.x, toes.z);
-    const double facing = yaw + clamp_magnitude(det::wrap_angle(static_cast<double>(p.mid_stance.heading) - yaw),
-                                                max_foot_turn(p.time));
+    const double turn_wanted = det::wrap_angle(static_cast<double>(t.heading) - yaw) + p.turned;
+    const double facing = yaw + clamp_magnitude(turn_wanted, max_foot_turn(p.time));
     const vec3 forward = heading_frame(facing).forward;
     const vec3 hip_now = root + t.h.left * (side_sign(foot) * t.rig.hip_half_width);
     const Placement placed = keep_off_obstacles(t.terrain, t.rig, place_foot_on_flat_spot(t.terrain, t.rig, spot.x, spot.z, forward),
@@ -772,8 +795,11 @@ Placement plan_target(const GaitState& g, const GaitTick& t, int foot, vec3 root
                             kMaxStrideRiseShare * (t.rig.thigh + t.rig.shin), t.c.max_step_height);
 }
 
-constexpr float kShortestSwing = 0.12f;           // s: a late lift-off still swings this long
-constexpr float kMaxMeanSwingSpeed = 4.0f;        // m/s: … and at least its travel over this
+// s: a late lift-off still swings this long. 0.12 s until gait20: a turn in
+// place re-aiming a swing late in its phase took a foot 0.31 m across and
+// 0.39 m down a hillside in 0.12 s and the shin spun (sweep case 14-0014,
+// foot joint 1,577 °/s).
+constexpr float kShortestSwing = 0.14f;
 constexpr float kWristDrag = 0.4f;                // hand tilt against its path's velocity, per m/cycle
 constexpr float kMaxPelvisVerticalSpeed = 0.9f;   // m/s the pelvis follows its height target at, at most
 // m/s the pelvis sinks at, at most, to meet a landing swing's soft limit: the

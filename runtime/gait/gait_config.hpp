@@ -37,7 +37,7 @@ struct GaitConfig {
     float step_length_multiplier = 0.45f;  // step length = multiplier · sqrt(speed)
     float min_step_duration = 0.26f;       // s, fastest cadence
     float max_step_duration = 0.6f;        // s, slowest cadence (slow walk, turning in place)
-    float walk_duty = 0.58f;               // fraction of a cycle each foot is down when walking (> 0.5)
+    float walk_duty = 0.58f;               // fraction of a cycle each foot is down when walking (> 0.5; a fast walk uses less: duty_for)
     float run_duty = 0.36f;                // … when running (< 0.5: flight phase)
     float run_threshold = 1.9f;            // m/s: above it the gait runs
     float swing_clearance = 0.03f;         // m the swing sole keeps above the ground between its ends
