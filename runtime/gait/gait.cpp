@@ -1064,7 +1064,8 @@ void start_stepping(GaitState& g, const GaitTick& t, double diff) {
     g.mode = GaitMode::stepping;
     // A foot still on its quick stop swing finishes it at its own pace (a
     // phase-driven pace from lift phase 0 would take a whole cycle while the
-    // root walks on); it lands where it was going and steps on from there.
+    // root walks on); it lands where it was going and steps on from there,
+    // unless the root leaves that spot behind (reaim_if_command_changed).
     for (FootState& f : g.feet)
         if (!f.swinging) f.timed_rate = 0.0f;
 }
@@ -1208,9 +1209,15 @@ void reaim_if_command_changed(GaitState& g, const GaitTick& t, vec3 root, int i)
     const bool stepping = g.mode == GaitMode::stepping && f.timed_rate == 0.0f;
     const vec3 hip_then = hip_at_landing(f, g, t, root, i);
     const float gap = horizontal_distance(f.target, hip_then);
-    const bool stranded = stepping && gap > kStrandedLandingM;
+    // A foot still on its stop swing when stepping resumed (start_stepping: it
+    // finishes at its own pace) is stranded as easily: the root runs off while
+    // it hovers toward a spot beside where the other foot stood. It re-aims too,
+    // phase-driven from then (gait21): left to land, one hovered 0.57 s while the
+    // root sped to 3 m/s, the pelvis sank to 0.33 m to reach it and the thigh
+    // spun at 2,551 °/s (sweep case 7-0755, sliding along a wall).
+    const bool stranded = g.mode == GaitMode::stepping && gap > kStrandedLandingM;
     const bool may_reaim =
-        stepping && ((command_changed && f.replanned < kMaxReaims && f.progress < kLatestReaimProgress) || stranded);
+        (stepping && command_changed && f.replanned < kMaxReaims && f.progress < kLatestReaimProgress) || stranded;
     if (!may_reaim) return;
     const float psi = swing_phase_now(f, g.cycle_phase, i);
     // A stranded swing is judged by the spot it would really be re-aimed at

@@ -551,6 +551,16 @@ TEST_CASE("gait sweep regressions: a late swing gets 0.14 s, no shin spins", "[g
                             {.every_limit = true});
 }
 
+// A foot still on its stop swing when stepping resumed re-aims when the root
+// leaves its spot behind (gait21): left to land, it hovered while the root sped
+// off and the pelvis sank to reach it. Each broke the joint-speed limit on
+// gait20 (°/s): walls 7-0755 2633, 4-0449 1693, 12-0159 1860, 12-0225 1976,
+// 13-0001 2040; stairs 8-0425 1784, 13-0211 2159; ramp 13-0231 1514.
+TEST_CASE("gait sweep regressions: a stop swing the root runs away from re-aims, no leg spins", "[gait_sweep]") {
+    check_sweep_regressions({{7, 755}, {4, 449}, {12, 159}, {12, 225}, {13, 1}, {8, 425}, {13, 211}, {13, 231}},
+                            {.every_limit = true});
+}
+
 // Known failures, kept so they stay found: cases a change fixed once and a
 // later change broke again (docs/gait.md). They may fail; the tests above hold
 // them to bounds they must not pass.
