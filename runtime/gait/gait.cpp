@@ -195,7 +195,21 @@ float foot_phase(float cycle_phase, int foot) { return frac(cycle_phase - (foot 
 // second key). The foot is posed by posed_swing_rotation: the same holds, the
 // turn between them even in time.
 constexpr float kHoldRotationShare = 0.1f;
+// Beside a wall a swing may turn its foot over the first or the second half of
+// the step instead (FootState::turn_order, set by begin_swing).
+struct TurnShares {
+    float from, to;
+};
+TurnShares turn_shares(const FootState& f) {
+    if (f.turn_order < 0) return {kHoldRotationShare, 0.5f};
+    if (f.turn_order > 0) return {0.5f, 1.0f - kHoldRotationShare};
+    return {kHoldRotationShare, 1.0f - kHoldRotationShare};
+}
 quat swing_rotation(const FootState& f, float s) {
+    if (f.turn_order != 0) {
+        const TurnShares t = turn_shares(f);
+        return quat_slerp(f.start_rotation, f.target_rotation, clampf((s - t.from) / (t.to - t.from), 0.0f, 1.0f));
+    }
     const float turn = clampf((s - kHoldRotationShare) / (1.0f - 2.0f * kHoldRotationShare), 0.0f, 1.0f);
     return quat_slerp(f.start_rotation, f.target_rotation, turn);
 }
@@ -333,7 +347,7 @@ constexpr float kMaxPathGrade = 1.0f;          // rise (or fall) per metre of tr
 // ankle height and swing_clearance. Monotone tangents keep the curve between two
 // keys within their heights, so the sole clears every sampled ground between
 // them: the path rises before a step up and comes down only past a step edge.
-void build_swing_path(FootState& f, const Terrain& whole_terrain, const GaitRig& rig, const GaitConfig& c, float blend) {
+bool build_swing_path(FootState& f, const Terrain& whole_terrain, const GaitRig& rig, const GaitConfig& c, float blend) {
     constexpr int n = kSwingPathKeys;
     // Every ground query below lies within the sole's reach (or the sideways
     // swing) of the straight line from start to target: the boxes there are
@@ -431,6 +445,12 @@ void build_swing_path(FootState& f, const Terrain& whole_terrain, const GaitRig&
     f.path_travel = travel;
     swing_path_keys(f, travel, f.path_keys);
     f.path_length = build_arc_length_table(f.path_keys);
+    // Whether the path climbs a wall: ground under it more than max_step_height
+    // above both ends of the step (begin_swing then tries another turn order).
+    const float wall = maxf(f.start_ground, f.target_ground) + c.max_step_height;
+    for (int i = 1; i + 1 < n; ++i)
+        if (ground[static_cast<std::size_t>(i)] > wall) return true;
+    return false;
 }
 
 // How much of the mid-swing reach allowance (kFullLegReachShare over the
@@ -526,7 +546,28 @@ void begin_swing(FootState& f, const Placement& target, const Terrain& terrain, 
     f.reaim_spin = vec3(0.0f);
     f.reaim_time = 0.0f;
     f.reaim_span = 0.0f;
-    build_swing_path(f, terrain, rig, c, blend);
+    // A foot turning beside a wall can sweep its toes through the wall's corner
+    // while both its spots are clear, and its path would climb the wall (sweep
+    // case 2-0085: toes 3.5 cm from a 1.09 m wall, turning 52° away from it
+    // while stepping 0.11 m toward it). A short step (under 0.3 m: a stop
+    // shuffle, a turn in place) then turns the foot over the first half of the
+    // step, or else the second, if that path is clear of the wall. A longer
+    // stride keeps its path over the wall: its clearance keys lie too far
+    // apart for a turn packed into half the step (sweep case 7-0196: a toe
+    // tip swept 449 mm below a 0.53 m wall's top).
+    f.turn_order = 0;
+    if (build_swing_path(f, terrain, rig, c, blend) && f.lift_scale < 1.0f) {
+        const FootState turning = f;
+        bool cleared = false;
+        for (std::int32_t order : {-1, 1}) {
+            f.turn_order = order;
+            if (!build_swing_path(f, terrain, rig, c, blend)) {
+                cleared = true;
+                break;
+            }
+        }
+        if (!cleared) f = turning;
+    }
     find_turn_window(f, rig, blend);
 }
 
@@ -588,8 +629,9 @@ float progress_at_reach(const FootState& f, const GaitRig& rig, float blend, flo
 // and its arc-length table are built; the blend may drift a little over the
 // swing, which moves the fraction's 0.1 and 0.9 by as little.
 void find_turn_window(FootState& f, const GaitRig& rig, float blend) {
-    f.turn_from = progress_at_reach(f, rig, blend, kHoldRotationShare);
-    f.turn_to = maxf(f.turn_from, progress_at_reach(f, rig, blend, 1.0f - kHoldRotationShare));
+    const TurnShares t = turn_shares(f);
+    f.turn_from = progress_at_reach(f, rig, blend, t.from);
+    f.turn_to = maxf(f.turn_from, progress_at_reach(f, rig, blend, t.to));
 }
 
 // The carried re-aim velocity's displacement after t of span T: v·t·(1 − t/T)²,

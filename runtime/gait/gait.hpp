@@ -40,6 +40,7 @@ struct FootState {
     float lift_phase = 0.0f;                  // the foot's cycle phase at lift-off (progress 0)
     float timed_rate = 0.0f;                  // > 0: progress per second (stop transition), else phase-driven
     float lift_scale = 1.0f;                  // small steps lift less
+    std::int32_t turn_order = 0;              // the foot turns mid-step (0), over its first (-1) or second (1) half (beside a wall)
     float reach_carry = 0.0f;                 // mid-swing reach allowance a re-aimed swing took over (docs/gait.md, Pelvis)
     std::int32_t replanned = 0;               // times this swing re-aimed (at most 3)
     float planned_speed = 0.0f;               // the command the target was planned for

@@ -96,6 +96,9 @@ void hash_gait(HashBytes& h, const GaitState& g) {
             const float turn[2] = {f.turn_from, f.turn_to};
             hash_floats(h, turn, 2);
         }
+        // Only for a swing turning over half its step (beside a wall): the
+        // others hash as they did before the field existed.
+        if (f.turn_order != 0) hash_ints(h, {f.turn_order});
     }
     hash_vec(h, g.pelvis);
     const float scalars[7] = {g.cycle_phase, g.speed, g.commanded_speed, g.run_blend, g.pelvis_base, g.lean, g.activity};

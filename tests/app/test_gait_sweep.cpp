@@ -561,6 +561,16 @@ TEST_CASE("gait sweep regressions: a stop swing the root runs away from re-aims,
                             {.every_limit = true});
 }
 
+// A short step turning beside a wall turns over the first or the second half of
+// the step when its mid-step turn would sweep the toes through the wall's
+// corner (gait22): 2-0085 lifted the foot 1.1 m over a 1.09 m wall instead
+// (7,465 °/s, the knee 23.8 mm inside the wall). 7-0196 is a running stride
+// beside a 0.53 m wall, which keeps its path over the wall: turning over its
+// second half instead put a toe tip 449 mm below the wall's top.
+TEST_CASE("gait sweep regressions: a short step turning beside a wall keeps its toes out of it", "[gait_sweep]") {
+    check_sweep_regressions({{2, 85}, {7, 196}}, {.every_limit = true});
+}
+
 // Known failures, kept so they stay found: cases a change fixed once and a
 // later change broke again (docs/gait.md). They may fail; the tests above hold
 // them to bounds they must not pass.
