@@ -2,6 +2,7 @@
 // walking and running (on flat ground and on rubble), with how many puppets one
 // core ticks at 240 Hz. Flush-to-zero is set as in run and replay.
 // Run: build/release/bench/marionette_bench_gait
+#include <array>
 #include <benchmark/benchmark.h>
 
 #include "bench_rubble.hpp"
@@ -31,6 +32,35 @@ void BM_TwoBoneIk(benchmark::State& state) {
         benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_TwoBoneIk);
+
+// The same solve four at a time (TwoBoneIkLanesJob: the puppet's two legs and
+// two arms, one per lane): ns_per_solve is the time of the four over four.
+void BM_TwoBoneIkLanes(benchmark::State& state) {
+    set_simulation_float_mode();
+    std::array<TwoBoneIkJob, 4> jobs;
+    for (std::size_t k = 0; k < jobs.size(); ++k) {
+        const float side = k % 2 == 0 ? 1.0f : -1.0f;
+        jobs[k].root = k < 2 ? vec3(0.09f * side, 0.84f, 0.0f) : vec3(0.18f * side, 1.38f, 0.0f);
+        jobs[k].upper_length = k < 2 ? 0.44f : 0.28f;
+        jobs[k].lower_length = k < 2 ? 0.43f : 0.26f;
+        jobs[k].pole = k < 2 ? vec3(0.0f, 0.0f, 1.0f) : vec3(0.3f * side, 0.0f, -1.0f);
+        jobs[k].hinge_sign = k < 2 ? 1.0f : -1.0f;
+    }
+    std::array<TwoBoneIkResult, 4> results;
+    float x = 0.0f;
+    for (auto _ : state) {
+        x = x > 0.3f ? -0.3f : x + 0.001f;  // moving targets, so nothing is hoisted
+        jobs[0].target = vec3(0.09f + 0.1f * x, 0.08f, x);
+        jobs[1].target = vec3(-0.09f - 0.1f * x, 0.08f, -x);
+        jobs[2].target = vec3(0.2f, 0.9f, 0.5f * x);
+        jobs[3].target = vec3(-0.2f, 0.9f, -0.5f * x);
+        if (!TwoBoneIkLanesJob{jobs, results}.run()) state.SkipWithError("TwoBoneIkLanesJob refused its inputs");
+        benchmark::DoNotOptimize(results);
+    }
+    state.counters["ns_per_solve"] = benchmark::Counter(static_cast<double>(state.iterations()) * 4.0,
+                                                        benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_TwoBoneIkLanes);
 
 void BM_GaitTick(benchmark::State& state) {
     set_simulation_float_mode();

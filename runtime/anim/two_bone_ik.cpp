@@ -1,6 +1,14 @@
 #include "runtime/anim/two_bone_ik.hpp"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#elif defined(__aarch64__)
+#include <arm_neon.h>
+#endif
 
 namespace marionette {
 
@@ -18,11 +26,16 @@ vec3 any_perpendicular(vec3 v) {
 }
 }  // namespace
 
-bool TwoBoneIkJob::validate() const {
-    return result && upper_length > 0.0f && lower_length > 0.0f && std::isfinite(upper_length) && std::isfinite(lower_length) &&
-           finite3(root) && finite3(target) && finite3(pole) && soft_reach_start > 0.0f && soft_reach_start <= 1.0f &&
-           min_reach_margin >= 0.0f;
+namespace {
+// What validate() asks of a job's inputs (the result pointer aside).
+bool inputs_valid(const TwoBoneIkJob& j) {
+    return j.upper_length > 0.0f && j.lower_length > 0.0f && std::isfinite(j.upper_length) && std::isfinite(j.lower_length) &&
+           finite3(j.root) && finite3(j.target) && finite3(j.pole) && j.soft_reach_start > 0.0f && j.soft_reach_start <= 1.0f &&
+           j.min_reach_margin >= 0.0f;
 }
+}  // namespace
+
+bool TwoBoneIkJob::validate() const { return result && inputs_valid(*this); }
 
 quat quat_from_axes(vec3 x, vec3 y, vec3 z) {
     // Matrix m[row][col] with columns x, y, z.
@@ -122,6 +135,200 @@ TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkJob& in) {
 bool TwoBoneIkJob::run() const {
     if (!validate()) return false;
     *result = solve_two_bone_ik(*this);
+    return true;
+}
+
+// The lane kernel. Every scalar float of solve_two_bone_ik is an F4 (one job
+// per lane) and every vec3 a V3 of three F4s; the expressions below are the
+// scalar ones, term for term, so each lane rounds exactly as the scalar code
+// does (-ffp-contract=off project-wide: no FMA). A branch of the scalar code
+// computes both sides here and selects per lane; the side a lane does not take
+// may divide by zero or take a negative square root, harmlessly (IEEE, no
+// traps), and is never selected.
+namespace {
+
+using F4 = float __attribute__((vector_size(16)));
+using M4 = std::int32_t __attribute__((vector_size(16)));  // a comparison: all ones (true) or zero per lane
+
+F4 splat(float v) { return F4{v, v, v, v}; }
+
+F4 sqrt4(F4 v) {
+#if defined(__SSE__)
+    return F4(_mm_sqrt_ps(__m128(v)));
+#elif defined(__aarch64__)
+    return F4(vsqrtq_f32(float32x4_t(v)));
+#else
+    return F4{std::sqrt(v[0]), std::sqrt(v[1]), std::sqrt(v[2]), std::sqrt(v[3])};
+#endif
+}
+
+// Per lane: `when` ? a : b (bit for bit).
+F4 select(M4 when, F4 a, F4 b) {
+    M4 ia, ib;
+    std::memcpy(&ia, &a, sizeof ia);
+    std::memcpy(&ib, &b, sizeof ib);
+    const M4 r = (ia & when) | (ib & ~when);
+    F4 out;
+    std::memcpy(&out, &r, sizeof out);
+    return out;
+}
+
+F4 abs4(F4 v) {
+    M4 bits;
+    std::memcpy(&bits, &v, sizeof bits);
+    bits &= M4{0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff};
+    std::memcpy(&v, &bits, sizeof v);
+    return v;
+}
+
+struct V3 {
+    F4 x, y, z;
+};
+V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+V3 operator-(V3 a) { return {-a.x, -a.y, -a.z}; }
+V3 operator*(V3 a, F4 s) { return {a.x * s, a.y * s, a.z * s}; }
+V3 operator/(V3 a, F4 s) { return {a.x / s, a.y / s, a.z / s}; }
+F4 dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+F4 length(V3 v) { return sqrt4(dot(v, v)); }
+V3 select(M4 when, V3 a, V3 b) { return {select(when, a.x, b.x), select(when, a.y, b.y), select(when, a.z, b.z)}; }
+V3 splat(vec3 v) { return {splat(v.x), splat(v.y), splat(v.z)}; }
+
+struct Q4 {
+    F4 w, x, y, z;
+};
+
+// any_perpendicular, per lane.
+V3 any_perpendicular4(V3 v) {
+    const M4 small_x = abs4(v.x) < splat(0.9f);
+    const V3 other = select(small_x, splat(vec3(1.0f, 0.0f, 0.0f)), splat(vec3(0.0f, 1.0f, 0.0f)));
+    const V3 p = cross(v, other);
+    return p / length(p);
+}
+
+// quat_normalize, per lane.
+Q4 normalize4(Q4 q) {
+    const F4 n2 = q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z;
+    const F4 inv = splat(1.0f) / sqrt4(n2);
+    const Q4 n{q.w * inv, q.x * inv, q.y * inv, q.z * inv};
+    const M4 positive = n2 > splat(0.0f);
+    return {select(positive, n.w, splat(1.0f)), select(positive, n.x, splat(0.0f)), select(positive, n.y, splat(0.0f)),
+            select(positive, n.z, splat(0.0f))};
+}
+
+// quat_from_axes, per lane. Each of Shepperd's four cases divides three of six
+// numerators by s and puts the quarter of s in the fourth component; each lane
+// picks its case's square root argument and three numerators (in component
+// order), so three divisions serve all four cases.
+Q4 from_axes4(V3 x, V3 y, V3 z) {
+    const F4 m00 = x.x, m11 = y.y, m22 = z.z;
+    const F4 trace = m00 + m11 + m22;
+    const M4 case0 = trace > splat(0.0f);
+    const M4 case1 = ~case0 & (m00 > m11) & (m00 > m22);
+    const M4 case2 = ~case0 & ~case1 & (m11 > m22);
+    const M4 case3 = ~case0 & ~case1 & ~case2;
+    const F4 one = splat(1.0f);
+    const F4 argument = select(case0, trace + one,
+                               select(case1, one + m00 - m11 - m22, select(case2, one + m11 - m00 - m22, one + m22 - m00 - m11)));
+    const F4 s = sqrt4(argument) * splat(2.0f);
+    const F4 quarter = splat(0.25f) * s;
+    const F4 a = y.z - z.y, b = z.x - x.z, c = x.y - y.x;  // the case's w (cases 1-3) or x, y, z (case 0)
+    const F4 d = y.x + x.y, e = z.x + x.z, f = z.y + y.z;
+    const F4 first = select(case0 | case1, a, select(case2, b, c)) / s;
+    const F4 second = select(case0, b, select(case1 | case2, d, e)) / s;
+    const F4 third = select(case0, c, select(case1, e, f)) / s;
+    return normalize4({select(case0, quarter, first), select(case0, first, select(case1, quarter, second)),
+                       select(case0 | case1, second, select(case2, quarter, third)), select(case3, quarter, third)});
+}
+
+// Whether any lane's mask is set (a branch around work no lane needs: the
+// selected values are the same either way).
+bool any(M4 m) { return (m[0] | m[1] | m[2] | m[3]) != 0; }
+
+}  // namespace
+
+void solve_two_bone_ik_lanes(std::span<const TwoBoneIkJob> jobs, std::span<TwoBoneIkResult> results) {
+    const std::size_t n = jobs.size() < results.size() ? jobs.size() : results.size();
+    if (n == 0) return;
+    // Unused lanes repeat the first job, so they hold ordinary numbers.
+    F4 a{}, b{}, margin{}, soft_start{}, sign{};
+    V3 root{}, target{}, pole_in{};
+    for (std::size_t lane = 0; lane < 4; ++lane) {
+        const TwoBoneIkJob& j = jobs[lane < n ? lane : 0];
+        a[lane] = j.upper_length;
+        b[lane] = j.lower_length;
+        margin[lane] = j.min_reach_margin;
+        soft_start[lane] = j.soft_reach_start;
+        sign[lane] = j.hinge_sign < 0.0f ? -1.0f : 1.0f;
+        root.x[lane] = j.root.x, root.y[lane] = j.root.y, root.z[lane] = j.root.z;
+        target.x[lane] = j.target.x, target.y[lane] = j.target.y, target.z[lane] = j.target.z;
+        pole_in.x[lane] = j.pole.x, pole_in.y[lane] = j.pole.y, pole_in.z[lane] = j.pole.z;
+    }
+    const F4 full = a + b;
+    const F4 fold = abs4(a - b) + margin * full;
+
+    const V3 to_target = target - root;
+    const F4 distance = length(to_target);
+    const F4 pole_length = length(pole_in);
+    const V3 pole = select(pole_length > splat(1e-12f), pole_in / pole_length, splat(vec3(0.0f, 0.0f, 1.0f)));
+    const M4 has_distance = distance > splat(1e-9f);
+    const V3 dir = any(~has_distance) ? select(has_distance, to_target / distance, any_perpendicular4(pole)) : to_target / distance;
+
+    const F4 soft = soft_start * full;
+    F4 reach = distance;
+    const M4 past_soft = reach > soft;
+    if (any(past_soft)) {
+        const F4 x = reach - soft;
+        const F4 r = full - soft;
+        const F4 eased = select(r > splat(0.0f), soft + r * x / (x + r), full);
+        reach = select(past_soft, eased, reach);
+    }
+    reach = select(reach < fold, fold, reach);
+    reach = select(reach > full, full, reach);
+
+    V3 bend = pole - dir * dot(pole, dir);
+    const F4 bend_length = length(bend);
+    const M4 has_bend = bend_length > splat(1e-6f);
+    bend = any(~has_bend) ? select(has_bend, bend / bend_length, any_perpendicular4(dir)) : bend / bend_length;
+
+    F4 cos_a = (a * a + reach * reach - b * b) / (splat(2.0f) * a * reach);
+    cos_a = select(cos_a > splat(1.0f), splat(1.0f), select(cos_a < splat(-1.0f), splat(-1.0f), cos_a));
+    const F4 sin_a = sqrt4(splat(1.0f) - cos_a * cos_a);
+    const V3 mid = root + dir * (a * cos_a) + bend * (a * sin_a);
+    const V3 end = root + dir * reach;
+
+    V3 hinge = cross(bend, dir);
+    hinge = hinge * (sign / length(hinge));
+    const V3 upper_y = -((mid - root) / a);
+    const V3 lower_y = -((end - mid) / b);
+    const Q4 upper = from_axes4(hinge, upper_y, cross(hinge, upper_y));
+    const Q4 lower = from_axes4(hinge, lower_y, cross(hinge, lower_y));
+    const V3 miss = end - target;
+    const M4 reached = dot(miss, miss) <= splat(1e-8f);
+
+    for (std::size_t lane = 0; lane < n; ++lane) {
+        TwoBoneIkResult& out = results[lane];
+        out.mid = vec3(mid.x[lane], mid.y[lane], mid.z[lane]);
+        out.end = vec3(end.x[lane], end.y[lane], end.z[lane]);
+        out.hinge_axis = vec3(hinge.x[lane], hinge.y[lane], hinge.z[lane]);
+        out.upper_rotation = quat(upper.w[lane], upper.x[lane], upper.y[lane], upper.z[lane]);
+        out.lower_rotation = quat(lower.w[lane], lower.x[lane], lower.y[lane], lower.z[lane]);
+        out.reach = reach[lane];
+        out.reached = reached[lane] != 0;
+    }
+}
+
+bool TwoBoneIkLanesJob::validate() const {
+    if (jobs.empty() || jobs.size() > 4 || results.size() != jobs.size()) return false;
+    for (const TwoBoneIkJob& j : jobs)
+        if (!inputs_valid(j)) return false;
+    return true;
+}
+
+bool TwoBoneIkLanesJob::run() const {
+    if (!validate()) return false;
+    solve_two_bone_ik_lanes(jobs, results);
     return true;
 }
 

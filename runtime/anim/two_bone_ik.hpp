@@ -12,6 +12,8 @@
 // the plane of root, target and pole direction, on the pole's side. For a knee
 // (pole ahead) a straight leg then has the rest frame; an elbow (pole behind)
 // sets hinge_sign = −1 so a straight arm has it too.
+#include <span>
+
 #include "runtime/math/math.hpp"
 
 namespace marionette {
@@ -61,5 +63,27 @@ quat quat_from_axes(vec3 x_axis, vec3 y_axis, vec3 z_axis);
 // half-angle identity q = normalize(1 + from·to, from × to); antiparallel vectors
 // turn about any perpendicular axis.
 quat quat_from_to(vec3 from, vec3 to);
+
+}  // namespace marionette
+
+namespace marionette {
+
+// Up to four solves at once (the legs, the arms), one per lane of a 4-lane
+// vector (SSE on x86-64, NEON on AArch64, GCC/Clang vector extensions
+// elsewhere). Each lane performs solve_two_bone_ik's operations in its order,
+// as separate IEEE operations, and its branches become lane selects of values
+// computed the same way: every result has the same bits as solve_two_bone_ik's
+// for that job (tests/runtime/anim/test_two_bone_ik_job.cpp compares them on
+// random jobs). Like solve_two_bone_ik it trusts its inputs (validate() each
+// job first); jobs.size() == results.size() <= 4.
+void solve_two_bone_ik_lanes(std::span<const TwoBoneIkJob> jobs, std::span<TwoBoneIkResult> results);
+
+// The jobs above as a job: validate() checks the counts and every job.
+struct TwoBoneIkLanesJob {
+    std::span<const TwoBoneIkJob> jobs;  // 1 to 4 jobs; their result pointers are not used
+    std::span<TwoBoneIkResult> results;  // out: one per job
+    bool validate() const;
+    [[nodiscard]] bool run() const;
+};
 
 }  // namespace marionette

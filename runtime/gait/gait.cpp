@@ -1568,11 +1568,6 @@ namespace {
 bool finite3(vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 bool positive_length(float metres) { return metres > 0.0f && std::isfinite(metres); }
 
-// Solves an IK job whose inputs GaitPoseJob::validate() vouched for (positive,
-// finite bone lengths, a finite state): validated once per pose, not again per
-// limb (TwoBoneIkJob::run would repeat the check four times a tick).
-TwoBoneIkResult solve_limb(const TwoBoneIkJob& ik) { return solve_two_bone_ik(ik); }
-
 // The knee's pole: the hip→ankle direction turned 90° forward about the hips'
 // left-right axis, so the knee points forward for a leg hanging down, up for a
 // foot raised ahead to hip height, down for a foot kicked back. A fixed forward
@@ -1628,44 +1623,73 @@ bool GaitPoseJob::run() const {
     pose.local_rotations[kNeck] = head;
     pose.local_rotations[kHead] = head;
 
-    // Legs: two-bone IK from each hip to its ankle, knees forward.
-    const int thighs[2] = {kThighL, kThighR};
+    // The shoulders first: their model transforms hang off the pelvis and spine
+    // alone (set above), so the arms' IK needs no full forward-kinematics pass
+    // before it. Computed with LocalToModelJob's arithmetic (quat_mul, then the
+    // parent's position plus quat_rotate), so they are the bits the full pass
+    // below writes again.
+    const int clavicles[2] = {kClavicleL, kClavicleR};
+    std::array<bool, kPuppetJointCount> shoulder_chain{};
+    for (int clavicle : clavicles)
+        for (int j = clavicle + 1; j != kNoParent; j = parents[static_cast<std::size_t>(j)]) shoulder_chain[static_cast<std::size_t>(j)] = true;
+    for (std::size_t j = 0; j < shoulder_chain.size(); ++j) {
+        if (!shoulder_chain[j]) continue;
+        const int p = parents[j];
+        if (p == kNoParent) {
+            pose.model_rotations[j] = pose.local_rotations[j];
+            pose.model_positions[j] = pose.local_translations[j];
+        } else {
+            const quat parent_rotation = pose.model_rotations[static_cast<std::size_t>(p)];
+            pose.model_rotations[j] = quat_mul(parent_rotation, pose.local_rotations[j]);
+            pose.model_positions[j] = pose.model_positions[static_cast<std::size_t>(p)] + quat_rotate(parent_rotation, pose.local_translations[j]);
+        }
+    }
+
+    // Four two-bone IK solves in one pass (TwoBoneIkLanesJob's kernel; the
+    // validation above covered its inputs): the legs from each hip to its ankle,
+    // knees forward, and the arms from each shoulder to the hand path, elbows
+    // back; the hands follow the blended hand paths, swinging against the legs.
+    std::array<TwoBoneIkJob, 4> limbs;
     for (int i = 0; i < 2; ++i) {
         const FootState& f = g.feet[static_cast<std::size_t>(i)];
-        TwoBoneIkJob ik;
+        TwoBoneIkJob& ik = limbs[static_cast<std::size_t>(i)];
         ik.root = g.pelvis + h.left * (side_sign(i) * r.hip_half_width);
         ik.target = f.ankle;
         ik.pole = knee_pole(h, ik.root, f.ankle);
         ik.upper_length = r.thigh;
         ik.lower_length = r.shin;
-        const TwoBoneIkResult s = solve_limb(ik);
-        const std::size_t thigh = static_cast<std::size_t>(thighs[i]);
-        pose.local_rotations[thigh] = quat_normalize(quat_mul(quat_conjugate(yaw), s.upper_rotation));
-        pose.local_rotations[thigh + 1] = quat_normalize(quat_mul(quat_conjugate(s.upper_rotation), s.lower_rotation));
-        pose.local_rotations[thigh + 2] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), f.rotation));
     }
-    // validate() checked what LocalToModelJob::validate() would (span sizes,
-    // parents in order): its kernel runs directly.
-    fk::local_to_model_vector(parents, pose.local(), pose.model());
-
-    // Arms: the hands follow the blended hand paths, swinging against the legs;
-    // elbows point back.
-    const int clavicles[2] = {kClavicleL, kClavicleR};
     const float hang = 0.95f * (r.upper_arm + r.forearm);
+    std::array<HermiteSample, 2> hands;
     for (int i = 0; i < 2; ++i) {
         const std::size_t clavicle = static_cast<std::size_t>(clavicles[i]);
         const vec3 shoulder = pose.model_positions[clavicle + 1];
-        const HermiteSample hand = blended_hand(r, g.run_blend, foot_phase(g.cycle_phase, i));
+        hands[static_cast<std::size_t>(i)] = blended_hand(r, g.run_blend, foot_phase(g.cycle_phase, i));
         const vec3 rest(0.03f, 0.0f, 0.02f);
-        const vec3 offset = lerp(rest, hand.position, g.activity);
-        TwoBoneIkJob ik;
+        const vec3 offset = lerp(rest, hands[static_cast<std::size_t>(i)].position, g.activity);
+        TwoBoneIkJob& ik = limbs[2 + static_cast<std::size_t>(i)];
         ik.root = shoulder;
         ik.target = shoulder + h.left * (side_sign(i) * offset.x) + vec3(0.0f, offset.y - hang, 0.0f) + h.forward * offset.z;
         ik.pole = -h.forward + h.left * (side_sign(i) * 0.3f);
         ik.upper_length = r.upper_arm;
         ik.lower_length = r.forearm;
         ik.hinge_sign = -1.0f;
-        const TwoBoneIkResult s = solve_limb(ik);
+    }
+    std::array<TwoBoneIkResult, 4> solved;
+    solve_two_bone_ik_lanes(limbs, solved);
+
+    const int thighs[2] = {kThighL, kThighR};
+    for (int i = 0; i < 2; ++i) {
+        const FootState& f = g.feet[static_cast<std::size_t>(i)];
+        const TwoBoneIkResult& s = solved[static_cast<std::size_t>(i)];
+        const std::size_t thigh = static_cast<std::size_t>(thighs[i]);
+        pose.local_rotations[thigh] = quat_normalize(quat_mul(quat_conjugate(yaw), s.upper_rotation));
+        pose.local_rotations[thigh + 1] = quat_normalize(quat_mul(quat_conjugate(s.upper_rotation), s.lower_rotation));
+        pose.local_rotations[thigh + 2] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), f.rotation));
+    }
+    for (int i = 0; i < 2; ++i) {
+        const std::size_t clavicle = static_cast<std::size_t>(clavicles[i]);
+        const TwoBoneIkResult& s = solved[2 + static_cast<std::size_t>(i)];
         const quat clavicle_rotation = pose.model_rotations[clavicle];
         pose.local_rotations[clavicle + 1] = quat_normalize(quat_mul(quat_conjugate(clavicle_rotation), s.upper_rotation));
         pose.local_rotations[clavicle + 2] = quat_normalize(quat_mul(quat_conjugate(s.upper_rotation), s.lower_rotation));
@@ -1674,23 +1698,15 @@ bool GaitPoseJob::run() const {
         // heading and sideways, by kWristDrag per metre per cycle; at rest it
         // continues the forearm. quat_from_to: half-angle identity, no trig.
         const vec3 forearm_down = quat_rotate(s.lower_rotation, vec3(0.0f, -1.0f, 0.0f));
-        const vec3 v = hand.velocity * g.activity;
+        const vec3 v = hands[static_cast<std::size_t>(i)].velocity * g.activity;
         const vec3 drag = h.forward * (-kWristDrag * v.z) + h.left * (-kWristDrag * side_sign(i) * v.x);
         const vec3 hand_down = normalize3(forearm_down + drag, forearm_down);
         const quat hand_rotation = quat_mul(quat_from_to(forearm_down, hand_down), s.lower_rotation);
         pose.local_rotations[clavicle + 3] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), hand_rotation));
     }
-    // Only the arms changed since the full pass (hands are leaves; nothing after
-    // them hangs off an arm): redo forward kinematics for those six joints, with
-    // LocalToModelJob's arithmetic, so the result is the same bits as a full pass.
-    for (int clavicle : {kClavicleL, kClavicleR})
-        for (int j = clavicle + 1; j <= clavicle + 3; ++j) {
-            const std::size_t k = static_cast<std::size_t>(j);
-            const std::size_t p = static_cast<std::size_t>(parents[k]);
-            const quat parent_rotation = pose.model_rotations[p];
-            pose.model_rotations[k] = quat_mul(parent_rotation, pose.local_rotations[k]);
-            pose.model_positions[k] = pose.model_positions[p] + quat_rotate(parent_rotation, pose.local_translations[k]);
-        }
+    // validate() checked what LocalToModelJob::validate() would (span sizes,
+    // parents in order): its kernel runs directly, once, over the whole pose.
+    fk::local_to_model_vector(parents, pose.local(), pose.model());
     return true;
 }
 

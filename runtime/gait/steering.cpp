@@ -1,6 +1,7 @@
 #include "runtime/gait/steering.hpp"
 
 #include <cmath>
+#include <cstring>
 
 #include "runtime/ground/obstacles.hpp"
 #include "runtime/math/det_math.hpp"
@@ -175,9 +176,15 @@ SteerResult steer_root(RootMotion& m, const SteerGoal& goal, const NearbyWalls& 
         const float down = brake * dt;
         m.speed = m.speed - r.target_speed > down ? m.speed - down : r.target_speed;
     }
-    double s = 0.0, co = 0.0;
-    det::sin_cos(m.heading, s, co);
-    const float fx = static_cast<float>(s), fz = static_cast<float>(co);
+    if (!m.facing_known || std::memcmp(&m.facing_heading, &m.heading, sizeof m.heading) != 0) {
+        double s = 0.0, co = 0.0;
+        det::sin_cos(m.heading, s, co);
+        m.facing_known = true;
+        m.facing_heading = m.heading;
+        m.facing_x = static_cast<float>(s);
+        m.facing_z = static_cast<float>(co);
+    }
+    const float fx = m.facing_x, fz = m.facing_z;
     const float limit = wall_speed_limit(walls, m.x, m.z, fx, fz, brake);
     if (m.speed > limit) m.speed = limit;
     m.x += fx * m.speed * dt;

@@ -46,6 +46,14 @@ struct RootMotion {
     float heading = 0.0f;
     float speed = 0.0f;
     std::int32_t turning_in_place = 0;
+    // The facing steer_root computed last, and for which heading: a prediction
+    // steps the law tick by tick, mostly with an unchanged heading, and then
+    // needs no new sine and cosine (the same bits either way). Not state: a
+    // function of `heading`.
+    bool facing_known = false;
+    float facing_heading = 0.0f;
+    float facing_x = 0.0f;
+    float facing_z = 0.0f;
 };
 
 // What one step of the law aimed for, after the walls.

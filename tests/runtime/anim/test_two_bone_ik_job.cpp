@@ -1,8 +1,12 @@
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
+#include <cstring>
+#include <span>
 
 #include "runtime/anim/two_bone_ik.hpp"
+#include "runtime/math/splitmix64.hpp"
 #include "tests/alloc_counter.hpp"
 
 using namespace marionette;
@@ -236,4 +240,74 @@ TEST_CASE("quaternions from axes and from vector pairs", "[ik]") {
     const vec3 to = vec3(0.48f, 0.6f, 0.64f);
     CHECK(distance(quat_rotate(quat_from_to(from, to), from), to) < 1e-5f);
     CHECK(distance(quat_rotate(quat_from_to(from, -from), from), -from) < 1e-5f);
+}
+
+namespace {
+bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool same_bits(vec3 a, vec3 b) { return same_bits(a.x, b.x) && same_bits(a.y, b.y) && same_bits(a.z, b.z); }
+bool same_bits(quat a, quat b) { return same_bits(a.w, b.w) && same_bits(a.x, b.x) && same_bits(a.y, b.y) && same_bits(a.z, b.z); }
+bool same_result(const TwoBoneIkResult& a, const TwoBoneIkResult& b) {
+    return same_bits(a.mid, b.mid) && same_bits(a.end, b.end) && same_bits(a.hinge_axis, b.hinge_axis) &&
+           same_bits(a.upper_rotation, b.upper_rotation) && same_bits(a.lower_rotation, b.lower_rotation) &&
+           same_bits(a.reach, b.reach) && a.reached == b.reached;
+}
+// A job drawn over the whole input envelope: limbs of any proportions, targets
+// near, at and past full reach and onto the root, any pole (zero and parallel
+// to the limb included), either hinge sign.
+TwoBoneIkJob random_job(std::uint64_t& rng) {
+    const auto uniform = [&](float lo, float hi) { return lo + (hi - lo) * static_cast<float>(splitmix64_unit(rng)); };
+    const auto direction = [&] {
+        vec3 v(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
+        const float n = std::sqrt(dot(v, v));
+        return n > 1e-3f ? v / n : vec3(0, -1, 0);
+    };
+    TwoBoneIkJob in;
+    in.root = vec3(uniform(-3, 3), uniform(-1, 2), uniform(-3, 3));
+    in.upper_length = uniform(0.05f, 0.6f);
+    in.lower_length = uniform(0.05f, 0.6f);
+    in.hinge_sign = uniform(0, 1) < 0.5f ? -1.0f : 1.0f;
+    in.soft_reach_start = uniform(0, 1) < 0.8f ? 0.98f : uniform(0.5f, 1.0f);
+    const float full = in.upper_length + in.lower_length;
+    const float kind = uniform(0, 1);
+    const vec3 dir = direction();
+    if (kind < 0.05f) in.target = in.root;                                  // onto the root
+    else if (kind < 0.15f) in.target = in.root + dir * (full * uniform(1.0f, 2.0f));  // past full reach
+    else in.target = in.root + dir * (full * uniform(0.0f, 1.0f));
+    const float pole_kind = uniform(0, 1);
+    if (pole_kind < 0.05f) in.pole = vec3(0.0f);                            // zero pole
+    else if (pole_kind < 0.1f) in.pole = dir * uniform(-2.0f, 2.0f);        // along the limb
+    else in.pole = direction() * uniform(0.1f, 2.0f);
+    return in;
+}
+}  // namespace
+
+TEST_CASE("the lane solve gives the scalar solve's bits for 1 to 4 random jobs", "[ik][job]") {
+    std::uint64_t rng = 0x1C0FFEEull;
+    for (int round = 0; round < 20000; ++round) {
+        const std::size_t count = 1 + static_cast<std::size_t>(round % 4);
+        std::array<TwoBoneIkJob, 4> jobs;
+        for (std::size_t k = 0; k < count; ++k) jobs[k] = random_job(rng);
+        std::array<TwoBoneIkResult, 4> lanes;
+        REQUIRE(TwoBoneIkLanesJob{std::span<const TwoBoneIkJob>(jobs.data(), count), std::span<TwoBoneIkResult>(lanes.data(), count)}.run());
+        for (std::size_t k = 0; k < count; ++k) {
+            const TwoBoneIkResult scalar = solve_two_bone_ik(jobs[k]);
+            INFO("round " << round << " lane " << k);
+            REQUIRE(same_result(lanes[k], scalar));
+        }
+    }
+}
+
+TEST_CASE("TwoBoneIkLanesJob refuses bad counts and bad jobs", "[ik][job]") {
+    std::array<TwoBoneIkJob, 5> jobs;
+    for (TwoBoneIkJob& j : jobs) j = leg(vec3(0.09f, 0.2f, 0.1f));
+    std::array<TwoBoneIkResult, 5> results;
+    CHECK(TwoBoneIkLanesJob{std::span<const TwoBoneIkJob>(jobs.data(), 4), std::span<TwoBoneIkResult>(results.data(), 4)}.validate());
+    CHECK_FALSE(TwoBoneIkLanesJob{std::span<const TwoBoneIkJob>(jobs.data(), 5), std::span<TwoBoneIkResult>(results.data(), 5)}.validate());
+    CHECK_FALSE(TwoBoneIkLanesJob{std::span<const TwoBoneIkJob>(jobs.data(), 0), std::span<TwoBoneIkResult>(results.data(), 0)}.validate());
+    CHECK_FALSE(TwoBoneIkLanesJob{std::span<const TwoBoneIkJob>(jobs.data(), 2), std::span<TwoBoneIkResult>(results.data(), 3)}.validate());
+    jobs[1].upper_length = -1.0f;
+    CHECK_FALSE(TwoBoneIkLanesJob{std::span<const TwoBoneIkJob>(jobs.data(), 2), std::span<TwoBoneIkResult>(results.data(), 2)}.run());
+    jobs[1].upper_length = 0.44f;
+    jobs[0].target.x = NAN;
+    CHECK_FALSE(TwoBoneIkLanesJob{std::span<const TwoBoneIkJob>(jobs.data(), 2), std::span<TwoBoneIkResult>(results.data(), 2)}.run());
 }
