@@ -18,15 +18,26 @@ std::size_t segment_of(std::span<const HermiteKey> keys, float time) {
     }
     return lo;
 }
+
+// segment_of(keys, time), trying `hint` first (the segment the previous lookup
+// found): the segment holding a time is the one i with keys[i].time <= time <
+// keys[i + 1].time, unique for sorted keys, and the binary search above returns
+// exactly that i, so a hint that brackets the time is the same answer. The
+// arc-length work looks up many times inside one table interval, and every
+// interval of a swing path lies inside one key segment.
+std::size_t segment_near(std::span<const HermiteKey> keys, float time, std::size_t& hint) {
+    if (!(hint + 1 < keys.size() && keys[hint].time <= time && time < keys[hint + 1].time)) hint = segment_of(keys, time);
+    return hint;
+}
 }  // namespace
 
 namespace {
 // sample_hermite(keys, time).velocity without the position: the same branches
 // and the same arithmetic, for the arc-length integration and the Newton steps,
 // which read only the speed (half of sample_hermite's work was a position they dropped).
-vec3 hermite_velocity(std::span<const HermiteKey> keys, float time) {
+vec3 hermite_velocity(std::span<const HermiteKey> keys, float time, std::size_t& hint) {
     if (keys.size() < 2 || !(time > keys.front().time) || !(time < keys.back().time)) return vec3(0.0f);
-    const std::size_t i = segment_of(keys, time);
+    const std::size_t i = segment_near(keys, time, hint);
     const HermiteKey& a = keys[i];
     const HermiteKey& b = keys[i + 1];
     const float h = b.time - a.time;
@@ -38,13 +49,13 @@ vec3 hermite_velocity(std::span<const HermiteKey> keys, float time) {
 
 // Length of the curve over [t0, t1]: 3-point Gauss–Legendre on |velocity|
 // (nodes 0, ±sqrt(3/5), weights 8/9, 5/9).
-float gauss_length(std::span<const HermiteKey> keys, float t0, float t1) {
+float gauss_length(std::span<const HermiteKey> keys, float t0, float t1, std::size_t& hint) {
     const float node = 0.7745966692414834f;
     const float mid = 0.5f * (t0 + t1);
     const float half = 0.5f * (t1 - t0);
-    const float speed_mid = length_of(hermite_velocity(keys, mid));
-    const float speed_lo = length_of(hermite_velocity(keys, mid - half * node));
-    const float speed_hi = length_of(hermite_velocity(keys, mid + half * node));
+    const float speed_mid = length_of(hermite_velocity(keys, mid, hint));
+    const float speed_lo = length_of(hermite_velocity(keys, mid - half * node, hint));
+    const float speed_hi = length_of(hermite_velocity(keys, mid + half * node, hint));
     return half * ((8.0f / 9.0f) * speed_mid + (5.0f / 9.0f) * (speed_lo + speed_hi));
 }
 }  // namespace
@@ -85,9 +96,10 @@ ArcLengthTable build_arc_length_table(std::span<const HermiteKey> keys) {
     table.end_time = keys.back().time;
     const float span = table.end_time - table.start_time;
     const float dt = span / static_cast<float>(kArcLengthIntervals);
+    std::size_t hint = 0;
     for (int i = 0; i < kArcLengthIntervals; ++i) {
         const float t0 = table.start_time + dt * static_cast<float>(i);
-        const float piece = gauss_length(keys, t0, t0 + dt);
+        const float piece = gauss_length(keys, t0, t0 + dt, hint);
         table.length[static_cast<std::size_t>(i) + 1] = table.length[static_cast<std::size_t>(i)] + piece;
     }
     return table;
@@ -114,11 +126,12 @@ float time_at_arc_length(std::span<const HermiteKey> keys, const ArcLengthTable&
     // instead (where the speed changes sharply inside the bracket, as on a
     // curve that climbs steeply and then runs flat, plain Newton overshoots).
     float a = t_lo, b = t_lo + dt;
+    std::size_t hint = 0;
     for (int iteration = 0; iteration < 3; ++iteration) {
-        const float covered = table.length[lo] + gauss_length(keys, t_lo, t);
+        const float covered = table.length[lo] + gauss_length(keys, t_lo, t, hint);
         if (covered < distance) a = t;
         else b = t;
-        const float speed_t = length_of(hermite_velocity(keys, t));
+        const float speed_t = length_of(hermite_velocity(keys, t, hint));
         float next = speed_t > 1e-6f ? t - (covered - distance) / speed_t : 0.5f * (a + b);
         if (!(next >= a && next <= b)) next = 0.5f * (a + b);
         t = next;
