@@ -1,6 +1,7 @@
 #include "runtime/gait/gait.hpp"
 
 #include <cmath>
+#include <cstring>
 
 #include "runtime/gait/puppet.hpp"
 #include "runtime/gait/steering.hpp"
@@ -896,11 +897,17 @@ constexpr float kGradeAheadM = 0.8f;
 constexpr float kMaxClimbSpeed = 0.6f;
 }  // namespace
 
-float ground_grade_along(const Terrain& terrain, float x, float z, float heading) {
-    const HeadingFrame h = heading_frame(heading);
+namespace {
+// ground_grade_along for a heading whose frame is at hand (update_gait has it).
+float grade_along(const Terrain& terrain, float x, float z, const HeadingFrame& h) {
     const float ahead = query_ground(terrain, x + h.forward.x * kGradeAheadM, z + h.forward.z * kGradeAheadM).height;
     const float behind = query_ground(terrain, x - h.forward.x * kGradeBehindM, z - h.forward.z * kGradeBehindM).height;
     return (ahead - behind) / (kGradeAheadM + kGradeBehindM);
+}
+}  // namespace
+
+float ground_grade_along(const Terrain& terrain, float x, float z, float heading) {
+    return grade_along(terrain, x, z, heading_frame(heading));
 }
 
 namespace {
@@ -918,11 +925,16 @@ float slope_speed_multiplier(const Terrain& terrain, const GaitConfig& c, float 
 
 // The grade is measured once (four ground queries and a heading frame): it used
 // to be measured again inside slope_speed_multiplier, with the same result.
-float ground_speed(const Terrain& terrain, const GaitConfig& c, float stick_fraction, float x, float z, float heading) {
-    const float signed_grade = ground_grade_along(terrain, x, z, heading);
+namespace {
+float speed_on_grade(const GaitConfig& c, float stick_fraction, float signed_grade) {
     const float grade = std::fabs(signed_grade);
     const float wanted = c.max_speed * stick_fraction * slope_multiplier_of_grade(c, signed_grade);
     return grade * wanted > kMaxClimbSpeed ? kMaxClimbSpeed / grade : wanted;
+}
+}  // namespace
+
+float ground_speed(const Terrain& terrain, const GaitConfig& c, float stick_fraction, float x, float z, float heading) {
+    return speed_on_grade(c, stick_fraction, ground_grade_along(terrain, x, z, heading));
 }
 
 GaitRig make_gait_rig(const GaitConfig& c) {
@@ -1027,9 +1039,8 @@ StickCommand read_stick(const GaitTickInput& in, const GaitConfig& c, float head
 struct StanceReach {
     float distance[2] = {-1.0f, -1.0f};
 };
-StanceReach stance_reach(const GaitState& g, vec3 root, float heading, const GaitRig& rig) {
+StanceReach stance_reach(const GaitState& g, vec3 root, const HeadingFrame& h, const GaitRig& rig) {
     StanceReach r;
-    const HeadingFrame h = heading_frame(heading);
     for (int i = 0; i < 2; ++i) {
         const FootState& f = g.feet[static_cast<std::size_t>(i)];
         if (!f.swinging) r.distance[i] = horizontal_distance(root + h.left * (side_sign(i) * rig.hip_half_width), f.ankle);
@@ -1068,7 +1079,7 @@ struct Steering {
 // than the lateral acceleration allows, the speed braked for sharp turns and
 // wide reversals turned in place once braked. A released stick stops at once.
 // Swings aimed for one way of moving re-aim when turning in place starts or ends.
-Steering steer(GaitState& g, float& heading, vec3& root, const StickCommand& cmd, const NearbyWalls& walls,
+Steering steer(GaitState& g, float& heading, HeadingFrame& frame, vec3& root, const StickCommand& cmd, const NearbyWalls& walls,
                const GaitConfig& c, const Terrain& terrain, float dt) {
     Steering s;
     s.result.heading = heading;
@@ -1078,7 +1089,7 @@ Steering steer(GaitState& g, float& heading, vec3& root, const StickCommand& cmd
         g.turning_in_place = 0;
         return s;
     }
-    g.commanded_speed = ground_speed(terrain, c, cmd.fraction, root.x, root.z, heading);
+    g.commanded_speed = speed_on_grade(c, cmd.fraction, grade_along(terrain, root.x, root.z, frame));
     s.goal = {cmd.dir_x, cmd.dir_z, cmd.desired_heading, g.commanded_speed};
     RootMotion m{root.x, root.z, heading, g.speed, g.turning_in_place};
     s.result = steer_root(m, s.goal, walls, c, dt);
@@ -1092,6 +1103,11 @@ Steering steer(GaitState& g, float& heading, vec3& root, const StickCommand& cmd
     heading = m.heading;
     root.x = m.x;
     root.z = m.z;
+    // steer_root's last sine and cosine are of the heading now: its frame, the
+    // bits heading_frame gives (float(−s) is −float(s)).
+    if (m.facing_known && std::memcmp(&m.facing_heading, &m.heading, sizeof m.heading) == 0)
+        frame = {vec3(m.facing_x, 0.0f, m.facing_z), vec3(m.facing_z, 0.0f, -m.facing_x)};
+    else frame = heading_frame(heading);
     return s;
 }
 
@@ -1544,9 +1560,10 @@ void update_gait(GaitState& g, vec3& root, float& heading, vec2& velocity, const
     const bool root_may_move = cmd.moving || g.mode != GaitMode::idle || root_settling(g, root);
     const NearbyWalls walls = root_may_move ? find_nearby_walls(terrain, c, root) : NearbyWalls{};
     const float from_x = root.x, from_z = root.z;
-    const StanceReach reach = stance_reach(g, root, heading, rig);
-    const Steering s = steer(g, heading, root, cmd, walls, c, terrain, dt);
-    const HeadingFrame h = heading_frame(heading);
+    // The heading's frame, before steering and (steer updates it) after.
+    HeadingFrame h = heading_frame(heading);
+    const StanceReach reach = stance_reach(g, root, h, rig);
+    const Steering s = steer(g, heading, h, root, cmd, walls, c, terrain, dt);
     keep_stance_in_reach(g, root, h, rig, reach);
     velocity = vec2(h.forward.x * g.speed, h.forward.z * g.speed);
     const double abs_diff = s.result.diff < 0 ? -s.result.diff : s.result.diff;
