@@ -923,9 +923,9 @@ float slope_speed_multiplier(const Terrain& terrain, const GaitConfig& c, float 
     return slope_multiplier_of_grade(c, ground_grade_along(terrain, x, z, heading));
 }
 
-// The grade is measured once (four ground queries and a heading frame): it used
-// to be measured again inside slope_speed_multiplier, with the same result.
 namespace {
+// The commanded speed on a measured grade (ground_speed, and update_gait with
+// the heading frame it already has).
 float speed_on_grade(const GaitConfig& c, float stick_fraction, float signed_grade) {
     const float grade = std::fabs(signed_grade);
     const float wanted = c.max_speed * stick_fraction * slope_multiplier_of_grade(c, signed_grade);
@@ -933,6 +933,8 @@ float speed_on_grade(const GaitConfig& c, float stick_fraction, float signed_gra
 }
 }  // namespace
 
+// The grade is measured once (four ground queries and a heading frame): it used
+// to be measured again inside slope_speed_multiplier, with the same result.
 float ground_speed(const Terrain& terrain, const GaitConfig& c, float stick_fraction, float x, float z, float heading) {
     return speed_on_grade(c, stick_fraction, ground_grade_along(terrain, x, z, heading));
 }
