@@ -3,6 +3,7 @@
 // Run: build/release/bench/marionette_bench_runtime
 #include <benchmark/benchmark.h>
 
+#include "runtime/anim/local_to_model.hpp"
 #include "runtime/formats/input_log.hpp"
 #include "runtime/gait/puppet.hpp"
 #include "runtime/sim/simulation.hpp"
@@ -11,27 +12,34 @@ using namespace marionette;
 
 namespace {
 
+// Arg 1: with the skeleton's FkSchedule (two joints per vector where the CPU
+// has AVX2: the tick's path); arg 0: without (one joint per vector).
 void BM_LocalToModel(benchmark::State& state) {
     set_simulation_float_mode();
     const SimConfig config;
     const Skeleton skeleton = make_puppet_skeleton(config);
     const Clip walk = make_walk_clip(skeleton, config);
+    const FkSchedule schedule(skeleton.parents);
     const size_t n = static_cast<size_t>(skeleton.joint_count());
     std::vector<quat> mr(n);
     std::vector<vec3> mp(n);
     const LocalToModelJob job{skeleton.parents,
                               {std::span<const quat>(walk.frame_rotations(10), n),
                                std::span<const vec3>(walk.frame_translations(10), n)},
-                              {mr, mp}};
+                              {mr, mp},
+                              state.range(0) != 0 ? &schedule : nullptr};
     for (auto _ : state) {
         if (!job.run()) state.SkipWithError("LocalToModelJob refused its inputs");
         benchmark::DoNotOptimize(mp.data());
         benchmark::ClobberMemory();
     }
+    state.SetLabel(state.range(0) == 0 ? "one joint per vector"
+                                       : (fk::pairs_kernel_available() ? "two joints per vector (AVX2)"
+                                                                       : "schedule given, no AVX2: one joint per vector"));
     state.counters["ns_per_joint"] =
         benchmark::Counter(static_cast<double>(state.iterations() * n), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
-BENCHMARK(BM_LocalToModel);
+BENCHMARK(BM_LocalToModel)->Arg(1)->Arg(0);
 
 void BM_SimulationTick(benchmark::State& state) {
     set_simulation_float_mode();

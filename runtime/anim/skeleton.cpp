@@ -43,12 +43,15 @@ Pose rest_pose(const Skeleton& s) {
 bool LocalToModelJob::validate() const {
     const size_t n = parents.size();
     return input.rotations.size() == n && input.translations.size() == n && output.rotations.size() >= n &&
-           output.positions.size() >= n && parents_in_topological_order(parents);
+           output.positions.size() >= n && (schedule ? schedule->matches(parents) : parents_in_topological_order(parents));
 }
 
 bool LocalToModelJob::run() const {
     if (!validate()) return false;
-    fk::local_to_model_vector(parents, input, output);
+    if (schedule)
+        fk::local_to_model_pairs(*schedule, input, output);
+    else
+        fk::local_to_model_vector(parents, input, output);
     return true;
 }
 

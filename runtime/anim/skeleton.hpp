@@ -7,6 +7,7 @@
 #include <string_view>
 #include <vector>
 
+#include "runtime/anim/fk_schedule.hpp"
 #include "runtime/anim/pose_spans.hpp"
 #include "runtime/errors/outcome.hpp"
 #include "runtime/math/math.hpp"
@@ -44,10 +45,15 @@ Pose rest_pose(const Skeleton& skeleton);
 // Forward kinematics: local transforms → model space, one pass in joint order.
 // A job (runtime/anim/pose_spans.hpp): validate() checks the sizes (the model
 // spans may be longer than the skeleton) and the topological order.
+// With a schedule built from the same parents (runtime/anim/fk_schedule.hpp,
+// built once per skeleton) it solves two joints per vector where the CPU has
+// AVX2; validate() then checks that the schedule matches the parents instead.
+// The bits are the same either way.
 struct LocalToModelJob {
     std::span<const int> parents;
     LocalPoseInput input;
     ModelPoseOutput output;
+    const FkSchedule* schedule = nullptr;
 
     bool validate() const;
     [[nodiscard]] bool run() const;

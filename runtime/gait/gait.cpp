@@ -1610,7 +1610,7 @@ vec3 knee_pole(const HeadingFrame& h, vec3 hip, vec3 ankle) {
 bool GaitPoseJob::validate() const {
     const std::size_t n = static_cast<std::size_t>(kPuppetJointCount);
     if (!gait || !rig || !config || parents.size() != n || rest_offsets.size() != n || !pose.has_joints(n) ||
-        !parents_in_topological_order(parents))
+        !(fk_schedule ? fk_schedule->matches(parents) : parents_in_topological_order(parents)))
         return false;
     const GaitRig& r = *rig;
     return positive_length(r.thigh) && positive_length(r.shin) && positive_length(r.upper_arm) &&
@@ -1724,8 +1724,12 @@ bool GaitPoseJob::run() const {
         pose.local_rotations[clavicle + 3] = quat_normalize(quat_mul(quat_conjugate(s.lower_rotation), hand_rotation));
     }
     // validate() checked what LocalToModelJob::validate() would (span sizes,
-    // parents in order): its kernel runs directly, once, over the whole pose.
-    fk::local_to_model_vector(parents, pose.local(), pose.model());
+    // parents in order or the schedule's): its kernel runs directly, once, over
+    // the whole pose.
+    if (fk_schedule)
+        fk::local_to_model_pairs(*fk_schedule, pose.local(), pose.model());
+    else
+        fk::local_to_model_vector(parents, pose.local(), pose.model());
     return true;
 }
 

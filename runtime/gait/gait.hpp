@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <span>
 
+#include "runtime/anim/fk_schedule.hpp"
 #include "runtime/anim/pose_spans.hpp"
 #include "runtime/math/hermite_spline.hpp"
 #include "runtime/gait/gait_config.hpp"
@@ -168,10 +169,13 @@ struct GaitPoseJob {
     std::span<const int> parents;
     std::span<const vec3> rest_offsets;
     PoseSpans pose;                        // out: locals and their forward kinematics
+    // Optional, built from `parents` (runtime/anim/fk_schedule.hpp): the forward
+    // kinematics solves two joints per vector where the CPU has AVX2.
+    const FkSchedule* fk_schedule = nullptr;
 
     // False without a state, rig or config, with spans not of the puppet's joint
-    // count, parents out of order, a bone length that is not positive, or a
-    // state the IK cannot solve (not finite). run() checks this once and then
+    // count, parents out of order (or not the fk_schedule's), a bone length that
+    // is not positive, or a state the IK cannot solve (not finite). run() checks this once and then
     // runs the four IK solves and forward kinematics without their own checks
     // (it covers theirs); the rest offsets are the caller's skeleton, not checked.
     bool validate() const;

@@ -170,6 +170,7 @@ Simulation::Simulation(const SimConfig& config, const Terrain& terrain) : config
     const Skeleton skeleton = make_puppet_skeleton(config_);
     if (skeleton.joint_count() > kMaxJoints) throw std::invalid_argument("puppet has too many joints");
     idle_clip_ = make_idle_clip(skeleton, config_);
+    puppet_fk_schedule_ = FkSchedule(idle_clip_.skeleton.parents);
     // The walk clip is built only for this hash, which every input log records:
     // dropping it refuses every existing log; it goes with the next log-format bump.
     const Clip walk_clip = make_walk_clip(skeleton, config_);
@@ -262,6 +263,7 @@ void Simulation::use_motion_graph(std::shared_ptr<const MotionGraph> graph, cons
     graph_matches_puppet_ = graph->skeleton.parents == puppet.parents && graph->skeleton.joint_names == puppet.joint_names;
     const std::vector<std::uint8_t> bytes = serialize_motion_graph(*graph);
     clip_data_hash_ ^= XXH64(bytes.data(), bytes.size(), 0x6D67726170680001ull);
+    graph_fk_schedule_ = FkSchedule(graph->skeleton.parents);
     graph_ = std::move(graph);
     graph_controller_ = std::move(controller);
     foot_rig_ = foot_rig;
@@ -304,7 +306,7 @@ void Simulation::step_graph(const TickInput& input, float dt, Pose& out) {
     const LocalPoseOutput local{pose.local_rotations, pose.local_translations};
     expect_job_ran(dt > 0.0f ? graph_controller_->step(s.graph, in, local) : graph_controller_->pose(s.graph, local));
     for (size_t j = 0; j < n; ++j) out.local_translations[j] *= metres_per_unit_;
-    expect_job_ran(LocalToModelJob{std::span<const int>(graph_->skeleton.parents), pose.local(), pose.model()}.run());
+    expect_job_ran(LocalToModelJob{std::span<const int>(graph_->skeleton.parents), pose.local(), pose.model(), &graph_fk_schedule_}.run());
 }
 
 void Simulation::place_feet(const Pose& clip, float dt, Pose& out, FootPlacementState& feet, std::uint8_t contacts,
@@ -334,7 +336,8 @@ void Simulation::pose_gait(const PoseSpans& out) const {
                           state_.breath_time,
                           std::span<const int>(puppet.parents),
                           std::span<const vec3>(puppet.rest_offsets),
-                          out};
+                          out,
+                          &puppet_fk_schedule_};
     expect_job_ran(job.run());
 }
 
@@ -427,7 +430,8 @@ void Simulation::output_blend(const Pose& from, const Pose& to, float weight, fl
     }
     const LocalToModelJob fk{std::span<const int>(skeleton().parents),
                              {std::span<const quat>(s.local_rotations.data(), n), std::span<const vec3>(s.local_translations.data(), n)},
-                             {std::span<quat>(s.model_rotations.data(), n), std::span<vec3>(s.model_positions.data(), n)}};
+                             {std::span<quat>(s.model_rotations.data(), n), std::span<vec3>(s.model_positions.data(), n)},
+                             skeleton_from_graph_ ? &graph_fk_schedule_ : &puppet_fk_schedule_};
     expect_job_ran(fk.run());
     const vec2 before(s.root_position.x, s.root_position.z);
     s.root_position = lerp(p_from, p_to, weight);
@@ -674,7 +678,7 @@ void Simulation::step_matching(const TickInput& input, float dt, Pose& out) {
     const PoseSpans pose = out.spans(n);
     const LocalPoseOutput local{pose.local_rotations, pose.local_translations};
     expect_job_ran(dt > 0.0f ? matching_->step(s.matching, in, local) : matching_->pose(s.matching, local));
-    expect_job_ran(LocalToModelJob{std::span<const int>(graph_->skeleton.parents), pose.local(), pose.model()}.run());
+    expect_job_ran(LocalToModelJob{std::span<const int>(graph_->skeleton.parents), pose.local(), pose.model(), &graph_fk_schedule_}.run());
 }
 
 }  // namespace marionette

@@ -153,6 +153,8 @@ private:
     SimConfig config_;
     Terrain terrain_;
     Clip idle_clip_;                   // its skeleton is the puppet's
+    FkSchedule puppet_fk_schedule_;    // forward kinematics' order for the puppet's skeleton
+    FkSchedule graph_fk_schedule_;     // and for the graph's (empty until a graph is attached)
     std::uint64_t clip_data_hash_ = 0;
     GaitRig rig_;
     std::shared_ptr<const MotionGraph> graph_;

@@ -1,5 +1,6 @@
-// The vector FK kernel (runtime/anim/local_to_model.cpp) against the scalar
-// reference, bit for bit, on generated skeletons and poses (fixed seed) across
+// The vector FK kernel (runtime/anim/local_to_model.cpp) and the pair kernel
+// (local_to_model_pairs.cpp, with its FkSchedule) against the scalar reference,
+// bit for bit, on generated skeletons and poses (fixed seed) across
 // the envelope: 1 to 300 joints, any parent shape (chains, stars, forests,
 // random trees), unit and non-unit rotations, and degenerate values (signed
 // zeros, subnormals, the largest floats, infinities, NaNs), with and without
@@ -19,6 +20,7 @@
 #include <xmmintrin.h>
 #endif
 
+#include "runtime/anim/fk_schedule.hpp"
 #include "runtime/anim/local_to_model.hpp"
 #include "runtime/anim/skeleton.hpp"
 
@@ -102,15 +104,22 @@ bool same_float(float a, float b) {
     return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b);
 }
 
-// Runs both kernels; returns "" when every output float matches, else where not.
-std::string compare_kernels(const Case& c, size_t& nan_results) {
+// Runs the scalar reference and `kernel` ("vector" or "pairs"); returns "" when
+// every output float matches, else where not.
+std::string compare_kernels(const Case& c, const std::string& kernel, size_t& nan_results) {
     const size_t n = c.parents.size();
     // One spare entry past the skeleton: the kernels must not write it.
     std::vector<quat> sr(n + 1, quat_wxyz(7, 7, 7, 7)), vr(n + 1, quat_wxyz(7, 7, 7, 7));
     std::vector<vec3> sp(n + 1, vec3(7)), vp(n + 1, vec3(7));
     const LocalPoseInput in{c.rotations, c.translations};
     fk::local_to_model_scalar(c.parents, in, {sr, sp});
-    fk::local_to_model_vector(c.parents, in, {vr, vp});
+    if (kernel == "pairs") {
+        const FkSchedule schedule(c.parents);
+        if (!schedule.valid()) return "no schedule for these parents";
+        fk::local_to_model_pairs(schedule, in, {vr, vp});
+    } else {
+        fk::local_to_model_vector(c.parents, in, {vr, vp});
+    }
     if (!(vr[n] == quat_wxyz(7, 7, 7, 7)) || !(vp[n] == vec3(7))) return "wrote past the skeleton's last joint";
     for (size_t i = 0; i < n; ++i)
         for (int k = 0; k < 4; ++k) {
@@ -124,31 +133,36 @@ std::string compare_kernels(const Case& c, size_t& nan_results) {
 }
 
 void check_generated(std::uint32_t seed, int cases, int degenerate) {
-    Gen g{std::mt19937(seed)};
-    size_t nan_results = 0;
-    for (int k = 0; k < cases; ++k) {
-        const size_t n = k < 8 ? static_cast<size_t>(k + 1) : 1 + g.below(g.below(4) == 0 ? 300 : 70);
-        const Case c = make_case(g, n, degenerate);
-        const std::string where = compare_kernels(c, nan_results);
-        INFO("seed " << seed << ", case " << k << ", " << n << " joints");
-        REQUIRE(where == "");
+    // The pair kernel runs as itself only on a CPU with AVX2; elsewhere it runs
+    // the vector kernel, and this compares that again.
+    if (!fk::pairs_kernel_available()) WARN("no AVX2 on this CPU: the pair kernel falls back to the vector kernel");
+    for (const std::string kernel : {"vector", "pairs"}) {
+        Gen g{std::mt19937(seed)};
+        size_t nan_results = 0;
+        for (int k = 0; k < cases; ++k) {
+            const size_t n = k < 8 ? static_cast<size_t>(k + 1) : 1 + g.below(g.below(4) == 0 ? 300 : 70);
+            const Case c = make_case(g, n, degenerate);
+            const std::string where = compare_kernels(c, kernel, nan_results);
+            INFO(kernel << " kernel, seed " << seed << ", case " << k << ", " << n << " joints");
+            REQUIRE(where == "");
+        }
+        if (degenerate == 2) CHECK(nan_results > 0);  // the envelope really reached NaN outputs
     }
-    if (degenerate == 2) CHECK(nan_results > 0);  // the envelope really reached NaN outputs
 }
 
 }  // namespace
 
-TEST_CASE("FK vector kernel: bit-identical to the scalar reference on generated unit poses", "[skeleton][job][fk]") {
+TEST_CASE("FK vector and pair kernels: bit-identical to the scalar reference on generated unit poses", "[skeleton][job][fk]") {
     check_generated(20201u, 1500, 0);
 }
 
-TEST_CASE("FK vector kernel: bit-identical on generated non-unit and degenerate values", "[skeleton][job][fk]") {
+TEST_CASE("FK vector and pair kernels: bit-identical on generated non-unit and degenerate values", "[skeleton][job][fk]") {
     check_generated(20202u, 1000, 1);
     check_generated(20203u, 1000, 2);
 }
 
 #if defined(__x86_64__) || defined(__i386__)
-TEST_CASE("FK vector kernel: bit-identical with flush-to-zero and denormals-are-zero", "[skeleton][job][fk]") {
+TEST_CASE("FK vector and pair kernels: bit-identical with flush-to-zero and denormals-are-zero", "[skeleton][job][fk]") {
     const unsigned saved = _mm_getcsr();
     _mm_setcsr(saved | 0x8040u);  // the tick's float mode (set_simulation_float_mode)
     check_generated(20204u, 500, 1);
@@ -157,18 +171,22 @@ TEST_CASE("FK vector kernel: bit-identical with flush-to-zero and denormals-are-
 }
 #endif
 
-TEST_CASE("LocalToModelJob::run gives the scalar reference's bits", "[skeleton][job][fk]") {
+TEST_CASE("LocalToModelJob::run gives the scalar reference's bits, with and without a schedule", "[skeleton][job][fk]") {
     Gen g{std::mt19937(20206u)};
     for (int k = 0; k < 200; ++k) {
         const Case c = make_case(g, 1 + g.below(64), 0);
         const size_t n = c.parents.size();
-        std::vector<quat> sr(n), jr(n);
-        std::vector<vec3> sp(n), jp(n);
+        const FkSchedule schedule(c.parents);
+        std::vector<quat> sr(n), jr(n), pr(n);
+        std::vector<vec3> sp(n), jp(n), pp(n);
         fk::local_to_model_scalar(c.parents, {c.rotations, c.translations}, {sr, sp});
         REQUIRE(LocalToModelJob{c.parents, {c.rotations, c.translations}, {jr, jp}}.run());
+        REQUIRE(LocalToModelJob{c.parents, {c.rotations, c.translations}, {pr, pp}, &schedule}.run());
         INFO("case " << k);
         REQUIRE(std::memcmp(sr.data(), jr.data(), n * sizeof(quat)) == 0);
         REQUIRE(std::memcmp(sp.data(), jp.data(), n * sizeof(vec3)) == 0);
+        REQUIRE(std::memcmp(sr.data(), pr.data(), n * sizeof(quat)) == 0);
+        REQUIRE(std::memcmp(sp.data(), pp.data(), n * sizeof(vec3)) == 0);
     }
 }
 
