@@ -1505,6 +1505,34 @@ PelvisLimits pelvis_limits(const GaitState& g, const GaitTick& t, vec3 pelvis) {
     return limit;
 }
 
+// How fast the pelvis must rise now (m/s, at most kSwingFoldRiseSpeed; 0 when
+// it need not rise) to be kSwingFoldShare of the leg above each swing path's
+// highest point still ahead by the time the ankle gets there. The path's keys
+// are its clearance levels; the set-down (the last kHoldRotationShare of the step) is left out: there the
+// landing's own limits hold the pelvis, and a rise demanded in the last ticks
+// of an uphill landing fought the soft limit (5-0498, a shin at 1,550 °/s).
+float swing_peak_rise(const GaitState& g, const GaitTick& t, float pelvis_y) {
+    float rate = 0.0f;
+    for (const FootState& f : g.feet) {
+        if (!f.swinging || f.path_travel <= 1e-6f) continue;
+        float peak = -kNoLimitM, peak_reach = 0.0f;
+        for (const HermiteKey& key : f.path_keys) {
+            const float reach = clampf(key.position.z / f.path_travel, 0.0f, 1.0f);
+            if (reach > f.fraction && reach < 1.0f - kHoldRotationShare && key.position.y > peak) {
+                peak = key.position.y;
+                peak_reach = reach;
+            }
+        }
+        const float peak_floor = peak + kSwingFoldShare * (t.rig.thigh + t.rig.shin);
+        if (peak_floor <= pelvis_y) continue;
+        const float peak_progress = progress_at_reach(f, t.rig, g.run_blend, peak_reach);
+        if (peak_progress <= f.progress) continue;
+        const float time_left = maxf(t.dt, (peak_progress - f.progress) / swing_rate(f, t));
+        rate = maxf(rate, minf(kSwingFoldRiseSpeed, (peak_floor - pelvis_y) / time_left));
+    }
+    return rate;
+}
+
 // The pelvis: its unlimited place, lowered to the soft limit at no more than
 // kMaxPelvisVerticalSpeed, or faster (up to kMaxPelvisSinkSpeed) where a swing
 // needs it to meet the soft limit by kSinkByProgress of its swing (evenly over
@@ -1529,6 +1557,14 @@ void place_pelvis(GaitState& g, const GaitTick& t, vec3 root, float breath_time)
     for (const FootState& f : g.feet)
         if (f.swinging) swing_floor = maxf(swing_floor, f.ankle.y + kSwingFoldShare * (t.rig.thigh + t.rig.shin));
     pelvis.y = maxf(pelvis.y, minf(swing_floor, previous_y + kSwingFoldRiseSpeed * t.dt));
+    // ... and rises ahead of the swing path's highest point: from where the
+    // ankle will be there, not only from where it is now. Following the ankle
+    // alone, the pelvis of a walk climbing two 22 cm risers in one step rose
+    // at kSwingFoldRiseSpeed only once the ankle was near its peak, too late:
+    // the ankle passed 0.18 m from its hip at 4.5 m/s and whipped the shin and
+    // foot (1,564 °/s, sweep case 7-0154).
+    const float peak_rise = swing_peak_rise(g, t, previous_y);
+    if (peak_rise > 0.0f) pelvis.y = maxf(pelvis.y, previous_y + peak_rise * t.dt);
     // A swinging foot left far behind (a swing stranded at its lift-off spot
     // a metre back and below while the root runs on across a hillside) pulled
     // the pelvis down to the planted ankle, and that leg's thigh flipped at

@@ -571,6 +571,15 @@ TEST_CASE("gait sweep regressions: a short step turning beside a wall keeps its 
     check_sweep_regressions({{2, 85}, {7, 196}}, {.every_limit = true});
 }
 
+// The pelvis rises ahead of a swing path's highest point, not only once the
+// ankle is there (gait23): climbing two risers in one step, the pelvis rose
+// too late and the ankle passed 0.18 m from its hip at 4.5 m/s. Each broke
+// the joint-speed limit on gait22 (°/s): stairs 7-0154 1564 (foot), 9-0263
+// 1548 (foot), 10-0428 1571 (shin).
+TEST_CASE("gait sweep regressions: the pelvis rises ahead of a two-riser step, no foot whips past the hip", "[gait_sweep]") {
+    check_sweep_regressions({{7, 154}, {9, 263}, {10, 428}}, {.every_limit = true});
+}
+
 // Known failures, kept so they stay found: cases a change fixed once and a
 // later change broke again (docs/gait.md). They may fail; the tests above hold
 // them to bounds they must not pass.
