@@ -853,6 +853,8 @@ constexpr float kMaxPelvisVerticalSpeed = 0.9f;   // m/s the pelvis follows its 
 constexpr float kMaxPelvisSinkSpeed = 3.0f;
 constexpr float kSwingFoldShare = 0.3f;           // of the leg: how far a swinging ankle stays below its hip
 constexpr float kSwingFoldRiseSpeed = 1.5f;       // m/s the pelvis may rise at to keep it there
+constexpr float kMaxStopSwingHipTurn = 12.0f;     // rad/s (~690 °/s) a stop swing's hip–ankle line may turn at
+constexpr float kMinStopSwingShare = 0.25f;       // of its timed progress a stop swing takes a tick, at least
 
 // Standing spot for a foot beside the other (planted) foot.
 Placement stop_target(const GaitState& g, int foot, float heading, const GaitRig& rig, const Terrain& terrain,
@@ -1314,14 +1316,39 @@ void reaim_if_command_changed(GaitState& g, const GaitTick& t, vec3 root, int i)
     f.planned_heading = t.desired_heading;
 }
 
-// A swinging foot moves on: at its own rate after a stop, else with the cycle's
+// The share of a stop swing's progress step (timed_rate) it may take this tick
+// so that the line from its hip to its ankle turns at no more than
+// kMaxStopSwingHipTurn: a stop swing is timed, and one starting with its foot
+// near its hip (stranded high on a tread beside it) swept past the hip at
+// 4.3 m/s, and the shin whipped with the hip–ankle line (sweep case 7-0283:
+// a foot 0.07 m below its hip, stopping 1 m across and 0.55 m down, foot
+// joint 1,575 °/s). Never less than kMinStopSwingShare, so the swing lands.
+// The small-angle test uses the tangent (|a × b| / a·b), no trigonometry.
+// Stepping swings keep their rate: they are timed by the cycle's phase.
+float hip_turn_share(const GaitState& g, const GaitTick& t, int i, float step) {
+    const FootState& f = g.feet[static_cast<std::size_t>(i)];
+    const vec3 hip = g.pelvis + t.h.left * (side_sign(i) * t.rig.hip_half_width);
+    const vec3 now = f.ankle - hip;
+    const vec3 next =
+        swing_point(f, i, t.rig, g.run_blend, t.h.left, minf(1.0f, f.progress + step)).ankle + reaim_offset(f) - hip;
+    const float turn_sine = length3(cross3(now, next));
+    const float turn_cosine = dot3(now, next);
+    const float max_turn = kMaxStopSwingHipTurn * t.dt;
+    if (turn_cosine <= 0.0f) return kMinStopSwingShare;
+    if (turn_sine <= max_turn * turn_cosine) return 1.0f;
+    return maxf(kMinStopSwingShare, max_turn * turn_cosine / turn_sine);
+}
+
+// A swinging foot moves on: at its own rate after a stop (slower while its
+// hip–ankle line would turn too fast: hip_turn_share), else with the cycle's
 // phase (over what was left of it at lift-off), but never slower than a
 // kShortestSwing swing. It lands at progress 1.
 void advance_swing(GaitState& g, const GaitTick& t, vec3 root, int i) {
     FootState& f = g.feet[static_cast<std::size_t>(i)];
-    const float rate = f.timed_rate > 0.0f
-                           ? f.timed_rate * t.dt
-                           : minf(t.dphase / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), t.dt / shortest_swing(f));
+    float rate = f.timed_rate > 0.0f
+                     ? f.timed_rate * t.dt
+                     : minf(t.dphase / maxf(kMinSwingPhaseShare, 1.0f - f.lift_phase), t.dt / shortest_swing(f));
+    if (f.timed_rate > 0.0f) rate *= hip_turn_share(g, t, i, rate);
     f.progress += rate;
     if (f.progress >= 1.0f) {
         land(f, g);

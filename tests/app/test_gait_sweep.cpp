@@ -580,6 +580,14 @@ TEST_CASE("gait sweep regressions: the pelvis rises ahead of a two-riser step, n
     check_sweep_regressions({{7, 154}, {9, 263}, {10, 428}}, {.every_limit = true});
 }
 
+// A stop swing slows while its hip–ankle line would turn faster than 12 rad/s
+// (gait24): a foot stranded 0.07 m below its hip on a tread stopped 1 m across
+// and 0.55 m down at 4.3 m/s past the hip (stairs 7-0283, foot 1,575 °/s on
+// gait23).
+TEST_CASE("gait sweep regressions: a stop swing from beside the hip slows, no shin whips", "[gait_sweep]") {
+    check_sweep_regressions({{7, 283}}, {.every_limit = true});
+}
+
 // Known failures, kept so they stay found: cases a change fixed once and a
 // later change broke again (docs/gait.md). They may fail; the tests above hold
 // them to bounds they must not pass.
