@@ -1542,17 +1542,19 @@ float swing_peak_rise(const GaitState& g, const GaitTick& t, float pelvis_y) {
     float rate = 0.0f;
     for (const FootState& f : g.feet) {
         if (!f.swinging || f.path_travel <= 1e-6f) continue;
-        float peak = -kNoLimitM, peak_reach = 0.0f;
-        for (const HermiteKey& key : f.path_keys) {
-            const float reach = clampf(key.position.z / f.path_travel, 0.0f, 1.0f);
-            if (reach > f.fraction && reach < 1.0f - kHoldRotationShare && key.position.y > peak) {
+        // Keys by their travel along the step (no division per key).
+        const float from = f.fraction * f.path_travel;
+        const float to = (1.0f - kHoldRotationShare) * f.path_travel;
+        float peak = -kNoLimitM, peak_travel = 0.0f;
+        for (const HermiteKey& key : f.path_keys)
+            if (key.position.z > from && key.position.z < to && key.position.y > peak) {
                 peak = key.position.y;
-                peak_reach = reach;
+                peak_travel = key.position.z;
             }
-        }
         const float peak_floor = peak + kSwingFoldShare * (t.rig.thigh + t.rig.shin);
         if (peak_floor <= pelvis_y) continue;
-        const float peak_progress = progress_at_reach(f, t.rig, g.run_blend, peak_reach);
+        const float peak_progress =
+            progress_at_reach(f, t.rig, g.run_blend, clampf(peak_travel / f.path_travel, 0.0f, 1.0f));
         if (peak_progress <= f.progress) continue;
         const float time_left = maxf(t.dt, (peak_progress - f.progress) / swing_rate(f, t));
         rate = maxf(rate, minf(kSwingFoldRiseSpeed, (peak_floor - pelvis_y) / time_left));
