@@ -1,5 +1,7 @@
 #include "runtime/anim/local_to_model.hpp"
 
+#include "runtime/anim/fk_schedule.hpp"
+
 #include <cstdint>
 #include <cstring>
 
@@ -155,6 +157,18 @@ void local_to_model_vector(std::span<const int> parents, const LocalPoseInput& i
         store_quat(model_rotations[i], previous_rotation);
         store_vec3(model_positions[i], previous_position);
     }
+}
+
+bool order_valid(std::span<const int> parents, const FkSchedule* schedule) {
+    return schedule ? schedule->matches(parents) : parents_in_topological_order(parents);
+}
+
+void local_to_model(std::span<const int> parents, const FkSchedule* schedule, const LocalPoseInput& input,
+                    const ModelPoseOutput& output) {
+    if (schedule)
+        local_to_model_pairs(*schedule, input, output);
+    else
+        local_to_model_vector(parents, input, output);
 }
 
 }  // namespace marionette::fk

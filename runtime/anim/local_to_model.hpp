@@ -28,4 +28,11 @@ void local_to_model_vector(std::span<const int> parents, const LocalPoseInput& i
 void local_to_model_pairs(const FkSchedule& schedule, const LocalPoseInput& input, const ModelPoseOutput& output);
 bool pairs_kernel_available();
 
+// What a job that runs FK uses, so each does it one way: the order check (the
+// schedule built from these parents, or without one the parents' own order)
+// and the kernel (the pair kernel with a schedule, else the vector kernel).
+bool order_valid(std::span<const int> parents, const FkSchedule* schedule);
+void local_to_model(std::span<const int> parents, const FkSchedule* schedule, const LocalPoseInput& input,
+                    const ModelPoseOutput& output);
+
 }  // namespace marionette::fk

@@ -43,15 +43,12 @@ Pose rest_pose(const Skeleton& s) {
 bool LocalToModelJob::validate() const {
     const size_t n = parents.size();
     return input.rotations.size() == n && input.translations.size() == n && output.rotations.size() >= n &&
-           output.positions.size() >= n && (schedule ? schedule->matches(parents) : parents_in_topological_order(parents));
+           output.positions.size() >= n && fk::order_valid(parents, schedule);
 }
 
 bool LocalToModelJob::run() const {
     if (!validate()) return false;
-    if (schedule)
-        fk::local_to_model_pairs(*schedule, input, output);
-    else
-        fk::local_to_model_vector(parents, input, output);
+    fk::local_to_model(parents, schedule, input, output);
     return true;
 }
 

@@ -1535,9 +1535,10 @@ PelvisLimits pelvis_limits(const GaitState& g, const GaitTick& t, vec3 pelvis) {
 // How fast the pelvis must rise now (m/s, at most kSwingFoldRiseSpeed; 0 when
 // it need not rise) to be kSwingFoldShare of the leg above each swing path's
 // highest point still ahead by the time the ankle gets there. The path's keys
-// are its clearance levels; the set-down (the last kHoldRotationShare of the step) is left out: there the
-// landing's own limits hold the pelvis, and a rise demanded in the last ticks
-// of an uphill landing fought the soft limit (5-0498, a shin at 1,550 °/s).
+// are its clearance levels; the set-down (the last kHoldRotationShare of the
+// step) is left out: there the landing's own limits hold the pelvis, and a
+// rise demanded in the last ticks of an uphill landing fought the soft limit
+// (5-0498, a shin at 1,550 °/s).
 float swing_peak_rise(const GaitState& g, const GaitTick& t, float pelvis_y) {
     float rate = 0.0f;
     for (const FootState& f : g.feet) {
@@ -1675,7 +1676,7 @@ vec3 knee_pole(const HeadingFrame& h, vec3 hip, vec3 ankle) {
 bool GaitPoseJob::validate() const {
     const std::size_t n = static_cast<std::size_t>(kPuppetJointCount);
     if (!gait || !rig || !config || parents.size() != n || rest_offsets.size() != n || !pose.has_joints(n) ||
-        !(fk_schedule ? fk_schedule->matches(parents) : parents_in_topological_order(parents)))
+        !fk::order_valid(parents, fk_schedule))
         return false;
     const GaitRig& r = *rig;
     return positive_length(r.thigh) && positive_length(r.shin) && positive_length(r.upper_arm) &&
@@ -1791,10 +1792,7 @@ bool GaitPoseJob::run() const {
     // validate() checked what LocalToModelJob::validate() would (span sizes,
     // parents in order or the schedule's): its kernel runs directly, once, over
     // the whole pose.
-    if (fk_schedule)
-        fk::local_to_model_pairs(*fk_schedule, pose.local(), pose.model());
-    else
-        fk::local_to_model_vector(parents, pose.local(), pose.model());
+    fk::local_to_model(parents, fk_schedule, pose.local(), pose.model());
     return true;
 }
 
