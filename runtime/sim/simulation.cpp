@@ -431,7 +431,7 @@ void Simulation::output_blend(const Pose& from, const Pose& to, float weight, fl
     const LocalToModelJob fk{std::span<const int>(skeleton().parents),
                              {std::span<const quat>(s.local_rotations.data(), n), std::span<const vec3>(s.local_translations.data(), n)},
                              {std::span<quat>(s.model_rotations.data(), n), std::span<vec3>(s.model_positions.data(), n)},
-                             skeleton_from_graph_ ? &graph_fk_schedule_ : &puppet_fk_schedule_};
+                             &fk_schedule()};
     expect_job_ran(fk.run());
     const vec2 before(s.root_position.x, s.root_position.z);
     s.root_position = lerp(p_from, p_to, weight);

@@ -135,6 +135,8 @@ private:
                     {model_rotations.data(), joints}, {model_positions.data(), joints}};
         }
     };
+    // The forward-kinematics schedule of skeleton(): the graph's or the puppet's.
+    const FkSchedule& fk_schedule() const { return skeleton_from_graph_ ? graph_fk_schedule_ : puppet_fk_schedule_; }
     void step_gait(const TickInput& input, float dt, const PoseSpans& out);
     void pose_gait(const PoseSpans& out) const;
     size_t gait_joint_count() const { return static_cast<size_t>(idle_clip_.skeleton.joint_count()); }
