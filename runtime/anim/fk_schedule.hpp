@@ -35,8 +35,11 @@ struct FkPairSlot {
 
 class FkSchedule {
 public:
-    // The most joints a schedule covers: its offsets are 32-bit.
-    static constexpr std::size_t kMaxJoints = std::size_t{1} << 24;
+    // The most joints a schedule covers. Building one scans the ready joints
+    // once per slot (quadratic for a star-shaped skeleton), so a bound keeps a
+    // huge imported skeleton from stalling its load: real ones have tens to a
+    // few hundred joints, and without a schedule the one-joint kernel runs.
+    static constexpr std::size_t kMaxJoints = 4096;
 
     FkSchedule() = default;  // covers no skeleton: matches() only an empty one
     // A schedule for these parents. When they are not in topological order or

@@ -125,6 +125,11 @@ TEST_CASE("FkSchedule: refuses parents out of order; matches only its own parent
     CHECK_FALSE(FkSchedule(std::vector<int>{0}).valid());
     CHECK_FALSE(FkSchedule(std::vector<int>{kNoParent, 2, 0}).valid());
     CHECK_FALSE(FkSchedule(std::vector<int>{kNoParent, -2}).valid());
+    std::vector<int> star(FkSchedule::kMaxJoints + 1, 0);
+    star[0] = kNoParent;
+    CHECK_FALSE(FkSchedule(star).valid());  // past the bound: no schedule, so no quadratic build
+    star.pop_back();
+    CHECK(FkSchedule(star).valid());
     CHECK_FALSE(FkSchedule(std::vector<int>{kNoParent, 0, 2}).matches(std::vector<int>{kNoParent, 0, 2}));
     CHECK(FkSchedule(std::vector<int>{}).matches(std::vector<int>{}));
     const std::vector<int> parents = {kNoParent, 0, 1, 0, 3};
