@@ -78,15 +78,30 @@ vec3 eval_keys(const std::array<HermiteKey, kMaxPrototypeKeys>& keys, int count,
     return sample_hermite(std::span<const HermiteKey>(keys.data(), static_cast<std::size_t>(count)), phase).position;
 }
 
+// The walk/run blend of two prototype samples, lerp(walk, run, blend). At
+// blend 0 (every walk below run_threshold − 0.3 m/s) that is walk + (run −
+// walk)·0, which is walk itself unless a component of walk is ±0 (then the sign
+// of run − walk decides the zero's sign): the run prototype is evaluated only
+// then, and the result is the same bits either way.
+bool has_zero(vec3 v) { return v.x == 0.0f || v.y == 0.0f || v.z == 0.0f; }
+template <class Run>
+vec3 blend_with(vec3 walk, float blend, const Run& run) {
+    if (blend == 0.0f && !has_zero(walk)) return walk;
+    return lerp(walk, run(), blend);
+}
+
 vec3 blended_swing(const GaitRig& rig, float blend, float u) {
-    return lerp(eval_keys(rig.walk.swing_foot, rig.walk.swing_count, u), eval_keys(rig.run.swing_foot, rig.run.swing_count, u), blend);
+    return blend_with(eval_keys(rig.walk.swing_foot, rig.walk.swing_count, u), blend,
+                      [&] { return eval_keys(rig.run.swing_foot, rig.run.swing_count, u); });
 }
 vec3 blended_pelvis(const GaitRig& rig, float blend, float phase) {
-    return lerp(eval_keys(rig.walk.pelvis, rig.walk.pelvis_count, phase), eval_keys(rig.run.pelvis, rig.run.pelvis_count, phase), blend);
+    return blend_with(eval_keys(rig.walk.pelvis, rig.walk.pelvis_count, phase), blend,
+                      [&] { return eval_keys(rig.run.pelvis, rig.run.pelvis_count, phase); });
 }
 // The hand path and its velocity (metres per cycle of phase).
 HermiteSample blended_hand(const GaitRig& rig, float blend, float phase) {
     const HermiteSample walk = sample_hermite(std::span<const HermiteKey>(rig.walk.hand.data(), static_cast<std::size_t>(rig.walk.hand_count)), phase);
+    if (blend == 0.0f && !has_zero(walk.position) && !has_zero(walk.velocity)) return walk;
     const HermiteSample run = sample_hermite(std::span<const HermiteKey>(rig.run.hand.data(), static_cast<std::size_t>(rig.run.hand_count)), phase);
     return {lerp(walk.position, run.position, blend), lerp(walk.velocity, run.velocity, blend)};
 }

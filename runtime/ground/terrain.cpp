@@ -12,10 +12,14 @@ struct Surface {
     vec3 normal;
 };
 
+// Whether the heightfield holds a grid (else it reads level ground at 0).
+bool heightfield_valid(const Heightfield& hf) {
+    return !(hf.nx < 2 || hf.nz < 2 || hf.heights.size() < static_cast<std::size_t>(hf.nx) * static_cast<std::size_t>(hf.nz) ||
+             !(hf.cell > 0.0f));
+}
+
 [[gnu::always_inline]] inline Surface heightfield_at(const Heightfield& hf, float x, float z) {
-    if (hf.nx < 2 || hf.nz < 2 || hf.heights.size() < static_cast<std::size_t>(hf.nx) * static_cast<std::size_t>(hf.nz) ||
-        !(hf.cell > 0.0f))
-        return {0.0f, vec3(0.0f, 1.0f, 0.0f)};
+    if (!heightfield_valid(hf)) return {0.0f, vec3(0.0f, 1.0f, 0.0f)};
     const float max_u = static_cast<float>(hf.nx - 1);
     const float max_v = static_cast<float>(hf.nz - 1);
     // A NaN coordinate reads the grid's first row or column (clamped like a
@@ -106,11 +110,16 @@ GroundWindow ground_window(const Terrain& terrain, float min_x, float min_z, flo
         }
         w.boxes[static_cast<std::size_t>(w.count++)] = static_cast<std::uint32_t>(i);
     }
+    bool slope_overlaps = false;
+    for (const TerrainSlope& s : terrain.slopes)
+        slope_overlaps = slope_overlaps || !(s.max_x < min_x || s.min_x > max_x || s.max_z < min_z || s.min_z > max_z);
+    w.level = !w.overflow && w.count == 0 && !slope_overlaps && !heightfield_valid(terrain.heightfield);
     return w;
 }
 
 namespace {
 [[gnu::always_inline]] inline Surface surface_in_window(const GroundWindow& w, float x, float z) {
+    if (w.level && inside(x, z, w.min_x, w.min_z, w.max_x, w.max_z)) return {0.0f, vec3(0.0f, 1.0f, 0.0f)};
     const Terrain& terrain = *w.terrain;
     Surface best = surface_below_boxes(terrain, x, z);
     // Every box gathered (a flat terrain: none at all): the terrain's own list, with no point test.

@@ -82,6 +82,9 @@ struct GroundWindow {
     const Terrain* terrain = nullptr;
     float min_x = 0.0f, min_z = 0.0f, max_x = 0.0f, max_z = 0.0f;
     bool overflow = false;  // more boxes overlap than fit: every query scans the terrain
+    // No box, slope or heightfield reaches the rectangle: a point inside it is
+    // on the level ground at 0 (what the full query gives there), with no scan.
+    bool level = false;
     int count = 0;
     std::array<std::uint32_t, kMaxWindowBoxes> boxes{};  // indices into terrain->boxes, ascending
 };

@@ -53,7 +53,7 @@ TEST_CASE("a ground window answers every query as its terrain does", "[terrain][
     std::mt19937 rng(20);
     std::uniform_real_distribution<float> at(-4.0f, 4.0f), extent(0.0f, 2.5f), unit(0.0f, 1.0f);
     std::uniform_int_distribution<int> pick(0, 9);
-    int windows = 0, overflowed = 0, points = 0;
+    int windows = 0, overflowed = 0, points = 0, level = 0;
     for (int c = 0; c < 400; ++c) {
         const Terrain t = random_terrain(rng);
         for (int w = 0; w < 4; ++w) {
@@ -66,6 +66,7 @@ TEST_CASE("a ground window answers every query as its terrain does", "[terrain][
             const GroundWindow win = ground_window(t, x0, z0, x1, z1);
             ++windows;
             overflowed += win.overflow ? 1 : 0;
+            level += win.level ? 1 : 0;
             for (int p = 0; p < 60; ++p) {
                 float x = at(rng), z = at(rng);
                 const int where = pick(rng);
@@ -84,6 +85,31 @@ TEST_CASE("a ground window answers every query as its terrain does", "[terrain][
     CHECK(windows == 1600);
     CHECK(points == 96000);
     CHECK(overflowed > 0);  // the overflow path was exercised
+    CHECK(level > 20);      // … and the level window's, which skips the scan inside it
+}
+
+// A window is level (its inside answered without a scan) only when no box,
+// slope or heightfield reaches it. A slope with a NaN bound holds no point; the
+// overlap test may still count it (then the full query answers, the same).
+TEST_CASE("a ground window is level only where nothing but level ground reaches it", "[terrain][ground_window]") {
+    Terrain t;
+    CHECK(ground_window(t, -1.0f, -1.0f, 1.0f, 1.0f).level);  // flat terrain
+    t.boxes.push_back({5.0f, 5.0f, 6.0f, 6.0f, 0.2f});
+    t.slopes.push_back({-6.0f, -6.0f, -5.0f, -5.0f, 0.0f, 0.1f, 0.0f});
+    const GroundWindow away = ground_window(t, -1.0f, -1.0f, 1.0f, 1.0f);
+    CHECK(away.level);
+    CHECK(query_ground(away, 0.5f, 0.5f).height == 0.0f);
+    CHECK(query_ground(away, 5.5f, 5.5f).height == 0.2f);  // outside the window: the whole terrain
+    CHECK_FALSE(ground_window(t, 4.0f, 4.0f, 5.0f, 5.0f).level);     // touches the box (closed edges)
+    CHECK_FALSE(ground_window(t, -5.5f, -5.5f, 0.0f, 0.0f).level);   // holds part of the slope
+    Terrain nan_slope;
+    nan_slope.slopes.push_back({std::numeric_limits<float>::quiet_NaN(), 0.0f, 1.0f, 1.0f, 0.0f, 0.1f, 0.0f});
+    const GroundWindow beside_nan = ground_window(nan_slope, -1.0f, -1.0f, 2.0f, 2.0f);
+    CHECK(query_ground(beside_nan, 0.5f, 0.5f).height == query_ground(nan_slope, 0.5f, 0.5f).height);
+    Terrain field;
+    field.heightfield = {20.0f, 20.0f, 0.5f, 3, 3, std::vector<float>(9, 0.3f)};  // far away, but read clamped everywhere
+    CHECK_FALSE(ground_window(field, -1.0f, -1.0f, 1.0f, 1.0f).level);
+    CHECK(query_ground(ground_window(field, -1.0f, -1.0f, 1.0f, 1.0f), 0.0f, 0.0f).height == query_ground(field, 0.0f, 0.0f).height);
 }
 
 TEST_CASE("a ground window gathers only the boxes overlapping it, in order", "[terrain][ground_window]") {

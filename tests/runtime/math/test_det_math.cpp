@@ -3,6 +3,9 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstring>
+#include <random>
+#include <vector>
 
 #include "runtime/math/det_math.hpp"
 #include "runtime/math/math.hpp"
@@ -53,6 +56,64 @@ TEST_CASE("wrap_angle maps into the interval from -pi (excluded) to pi", "[det_m
     CHECK(det::wrap_angle(-det::kPi) == Approx(det::kPi));
     CHECK(det::wrap_angle(0.25) == Approx(0.25));
     CHECK(det::wrap_angle(det::kTwoPi + 0.25) == Approx(0.25));
+}
+
+namespace {
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+}  // namespace
+
+// wrap_angle returns an angle already in (−pi, pi] without its division: the
+// same bits as the formula (radians − 2pi·nearbyint(radians / 2pi), then one
+// turn added or taken off at the ends), −0 included (the formula gives +0).
+TEST_CASE("wrap_angle gives the formula's bits inside its interval and outside it", "[det_math]") {
+    const auto formula = [](double r) {
+        double w = r - det::kTwoPi * std::nearbyint(r / det::kTwoPi);
+        if (w <= -det::kPi) w += det::kTwoPi;
+        if (w > det::kPi) w -= det::kTwoPi;
+        return w;
+    };
+    std::mt19937_64 rng(31);
+    std::uniform_real_distribution<double> near(-4.0, 4.0), far(-1e7, 1e7);
+    std::vector<double> values = {0.0, -0.0, det::kPi, -det::kPi, std::nextafter(det::kPi, 0.0), std::nextafter(det::kPi, 4.0),
+                                  std::nextafter(-det::kPi, 0.0), std::nextafter(-det::kPi, -4.0), det::kTwoPi, -det::kTwoPi,
+                                  1e-300, -1e-300, 3.0 * det::kPi, -3.0 * det::kPi, 1e300, -1e300};
+    for (int i = 0; i < 200000; ++i) values.push_back(i % 2 ? near(rng) : far(rng));
+    for (double r : values) {
+        INFO(r);
+        REQUIRE(same_bits(det::wrap_angle(r), formula(r)));
+    }
+    CHECK(std::signbit(det::wrap_angle(-0.0)) == false);
+}
+
+// atan's Taylor coefficients are a table computed at compile time; the same
+// series with each coefficient divided out at run time, as it was, gives the
+// same bits.
+TEST_CASE("det::atan gives the bits of the series with run-time coefficients", "[det_math]") {
+    const auto small = [](double x) {
+        const double x2 = x * x;
+        double p = 0.0;
+        for (int k = 16; k >= 0; --k) {
+            const double term = 1.0 / static_cast<double>(2 * k + 1);
+            p = p * x2 + ((k % 2 == 0) ? term : -term);
+        }
+        return x * p;
+    };
+    const auto reference = [&](double x) {
+        const bool negative = x < 0.0;
+        const double a = negative ? -x : x;
+        double result;
+        if (a > 2.41421356237309504880) result = det::kHalfPi - small(1.0 / a);
+        else if (a > 0.41421356237309504880) result = det::kPi / 4.0 + small((a - 1.0) / (a + 1.0));
+        else result = small(a);
+        return negative ? -result : result;
+    };
+    std::mt19937_64 rng(32);
+    std::uniform_real_distribution<double> unit(-3.0, 3.0);
+    for (int i = 0; i < 100000; ++i) {
+        const double x = i % 3 == 0 ? unit(rng) : (i % 3 == 1 ? std::ldexp(unit(rng), i % 40 - 20) : 1.0 / unit(rng));
+        INFO(x);
+        REQUIRE(same_bits(det::atan(x), reference(x)));
+    }
 }
 
 TEST_CASE("quaternion helpers agree with GLM's reference implementations", "[math]") {
