@@ -75,7 +75,7 @@ int build_prototype_keys(const SplinePrototype& p, bool loops, std::array<Hermit
 namespace {
 
 vec3 eval_keys(const std::array<HermiteKey, kMaxPrototypeKeys>& keys, int count, float phase) {
-    return sample_hermite(std::span<const HermiteKey>(keys.data(), static_cast<std::size_t>(count)), phase).position;
+    return sample_hermite_position(std::span<const HermiteKey>(keys.data(), static_cast<std::size_t>(count)), phase);
 }
 
 // The walk/run blend of two prototype samples, lerp(walk, run, blend). At
@@ -604,7 +604,7 @@ SwingPoint swing_point(const FootState& f, int foot, const GaitRig& rig, float b
     const std::span<const HermiteKey> path(f.path_keys.data(), f.path_keys.size());
     const float total = f.path_length.total();
     const float s = total > 1e-6f ? clampf(time_at_arc_length(path, f.path_length, share * total), 0.0f, 1.0f) : share;
-    const vec3 on_path = sample_hermite(path, s).position;  // (0, height, travel along the step)
+    const vec3 on_path = sample_hermite_position(path, s);  // (0, height, travel along the step)
     const float reach = distance > 1e-6f ? clampf(on_path.z / distance, 0.0f, 1.0f) : s;
     // The sideways swing fades out over the straight lift-off and set-down, so
     // the foot leaves and reaches its spots straight up and down.

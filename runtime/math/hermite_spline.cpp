@@ -89,6 +89,20 @@ HermiteSample sample_hermite(std::span<const HermiteKey> keys, float time) {
     return out;
 }
 
+vec3 sample_hermite_position(std::span<const HermiteKey> keys, float time) {
+    if (keys.empty()) return vec3(0.0f);
+    if (keys.size() == 1 || !(time > keys.front().time)) return keys.front().position;
+    if (!(time < keys.back().time)) return keys.back().position;
+    const std::size_t i = segment_of(keys, time);
+    const HermiteKey& a = keys[i];
+    const HermiteKey& b = keys[i + 1];
+    const float h = b.time - a.time;
+    if (!(h > 0.0f)) return b.position;
+    const float s = (time - a.time) / h;
+    const HermiteBasis w = hermite_basis(s);
+    return a.position * w.h00 + a.tangent * (w.h10 * h) + b.position * w.h01 + b.tangent * (w.h11 * h);
+}
+
 ArcLengthTable build_arc_length_table(std::span<const HermiteKey> keys) {
     ArcLengthTable table;
     if (keys.size() < 2) return table;

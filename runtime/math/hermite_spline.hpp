@@ -33,6 +33,10 @@ HermiteBasis hermite_basis_derivative(float s);
 // clamped to the end key (velocity zero there), so a finished swing stays put.
 // One key: that key's position. No keys: the origin.
 HermiteSample sample_hermite(std::span<const HermiteKey> keys, float time);
+// sample_hermite(keys, time).position alone: the same branches and the same
+// arithmetic, without the velocity (its basis derivative and division), for
+// the callers that read only where the curve is.
+vec3 sample_hermite_position(std::span<const HermiteKey> keys, float time);
 
 // Cumulative arc length at evenly spaced times over the keys' span, so that
 // distance along the curve maps back to time (arc-length reparameterisation).
