@@ -32,6 +32,18 @@ std::size_t segment_near(std::span<const HermiteKey> keys, float time, std::size
 }  // namespace
 
 namespace {
+// The position and the velocity at fraction s of the segment from a to b
+// (h = b.time − a.time > 0): every sampler computes them here, so the position
+// alone and the speed alone are the full sample's bits.
+[[gnu::always_inline]] inline vec3 segment_position(const HermiteKey& a, const HermiteKey& b, float h, float s) {
+    const HermiteBasis w = hermite_basis(s);
+    return a.position * w.h00 + a.tangent * (w.h10 * h) + b.position * w.h01 + b.tangent * (w.h11 * h);
+}
+[[gnu::always_inline]] inline vec3 segment_velocity(const HermiteKey& a, const HermiteKey& b, float h, float s) {
+    const HermiteBasis d = hermite_basis_derivative(s);
+    return (a.position * d.h00 + a.tangent * (d.h10 * h) + b.position * d.h01 + b.tangent * (d.h11 * h)) / h;
+}
+
 // sample_hermite(keys, time).velocity without the position: the same branches
 // and the same arithmetic, for the arc-length integration and the Newton steps,
 // which read only the speed (half of sample_hermite's work was a position they dropped).
@@ -42,9 +54,7 @@ vec3 hermite_velocity(std::span<const HermiteKey> keys, float time, std::size_t&
     const HermiteKey& b = keys[i + 1];
     const float h = b.time - a.time;
     if (!(h > 0.0f)) return vec3(0.0f);
-    const float s = (time - a.time) / h;
-    const HermiteBasis d = hermite_basis_derivative(s);
-    return (a.position * d.h00 + a.tangent * (d.h10 * h) + b.position * d.h01 + b.tangent * (d.h11 * h)) / h;
+    return segment_velocity(a, b, h, (time - a.time) / h);
 }
 
 // Length of the curve over [t0, t1]: 3-point Gauss–Legendre on |velocity|
@@ -81,12 +91,7 @@ HermiteSample sample_hermite(std::span<const HermiteKey> keys, float time) {
     const float h = b.time - a.time;
     if (!(h > 0.0f)) return {b.position, vec3(0.0f)};
     const float s = (time - a.time) / h;
-    const HermiteBasis w = hermite_basis(s);
-    const HermiteBasis d = hermite_basis_derivative(s);
-    HermiteSample out;
-    out.position = a.position * w.h00 + a.tangent * (w.h10 * h) + b.position * w.h01 + b.tangent * (w.h11 * h);
-    out.velocity = (a.position * d.h00 + a.tangent * (d.h10 * h) + b.position * d.h01 + b.tangent * (d.h11 * h)) / h;
-    return out;
+    return {segment_position(a, b, h, s), segment_velocity(a, b, h, s)};
 }
 
 vec3 sample_hermite_position(std::span<const HermiteKey> keys, float time) {
@@ -98,9 +103,7 @@ vec3 sample_hermite_position(std::span<const HermiteKey> keys, float time) {
     const HermiteKey& b = keys[i + 1];
     const float h = b.time - a.time;
     if (!(h > 0.0f)) return b.position;
-    const float s = (time - a.time) / h;
-    const HermiteBasis w = hermite_basis(s);
-    return a.position * w.h00 + a.tangent * (w.h10 * h) + b.position * w.h01 + b.tangent * (w.h11 * h);
+    return segment_position(a, b, h, (time - a.time) / h);
 }
 
 ArcLengthTable build_arc_length_table(std::span<const HermiteKey> keys) {
